@@ -1,0 +1,1 @@
+"""Behaviour files for pHelmIvP and a small pure-Python helm that runs them."""

@@ -1,0 +1,1 @@
+"""Console-scriptless package marker for bench: run with python -m bench."""

@@ -1,0 +1,1 @@
+"""The launcher (goby_launch's file format) and the missions."""

@@ -1,0 +1,50 @@
+"""Suite-wide fixtures: every test must stop the threads and child processes it started."""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+LEAK_GRACE_S = 5.0
+
+
+def _child_pids() -> set[int]:
+    """Live (non-zombie) direct children of this process, read from /proc."""
+    me = os.getpid()
+    children: set[int] = set()
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        state, ppid = fields[0], int(fields[1])
+        if ppid == me and state != "Z":
+            children.add(int(stat.parent.name))
+    return children
+
+
+@pytest.fixture(autouse=True)
+def no_leaked_threads_or_processes(request: pytest.FixtureRequest):
+    """Fail a test that leaves a thread or a child process running (like python-can's channel check)."""
+    threads_before = set(threading.enumerate())
+    children_before = _child_pids()
+    yield
+    deadline = time.monotonic() + LEAK_GRACE_S
+    while True:
+        threads = [t for t in threading.enumerate() if t not in threads_before and t.is_alive()]
+        children = _child_pids() - children_before
+        if not threads and not children:
+            return
+        if time.monotonic() > deadline:
+            break
+        time.sleep(0.05)
+    problems = []
+    if threads:
+        problems.append("threads still running: " + ", ".join(t.name for t in threads))
+    if children:
+        problems.append("child processes still running: " + ", ".join(map(str, sorted(children))))
+    pytest.fail(f"{request.node.nodeid} leaked " + "; ".join(problems), pytrace=False)
