@@ -1,0 +1,37 @@
+"""Exceptions of the frontseat subsystem: one root, one subclass per kind of failure.
+
+A driver's ``loop()`` raises :class:`HelmErrorException` or :class:`FrontSeatErrorException` to push the
+interface into HELM_ERROR or FS_ERROR (Goby's ``frontseat::Exception`` with a HelmError/FrontSeatError).
+"""
+
+from __future__ import annotations
+
+from frontseat.protobuf import frontseat_pb2 as fs_pb
+
+
+class FrontSeatException(Exception):
+    """Root of every frontseat error."""
+
+
+class HelmErrorException(FrontSeatException):
+    """The helm is in error; carries a ``HelmError`` enum value."""
+
+    def __init__(self, helm_error: int) -> None:
+        self.helm_error = helm_error
+        super().__init__(fs_pb.HelmError.Name(helm_error))
+
+
+class FrontSeatErrorException(FrontSeatException):
+    """The frontseat is in error; carries a ``FrontSeatError`` enum value."""
+
+    def __init__(self, frontseat_error: int) -> None:
+        self.frontseat_error = frontseat_error
+        super().__init__(fs_pb.FrontSeatError.Name(frontseat_error))
+
+
+class DriverLoadError(FrontSeatException):
+    """The driver library named by ``FRONTSEAT_DRIVER_LIBRARY`` could not be loaded or used."""
+
+
+class ConfigError(FrontSeatException):
+    """A configuration value is missing or out of range."""
