@@ -1,0 +1,17 @@
+"""The applications we ship, and the modules whose code makes up each one's interface.
+
+A gateway plugin is listed as its own entry whose interface is merged into ``moos-gateway`` in a deployment
+(the ``application:`` override of a deployment entry), as Goby lists its plugin libraries.
+"""
+
+from __future__ import annotations
+
+SHIPPED_APPLICATIONS: dict[str, list[str]] = {
+    "frontseat-interface": ["frontseat.interface_app"],
+    "usv-manager": ["translators.usv.manager"],
+    "usv-command": ["translators.usv.command_cli"],
+    "moos-gateway-frontseat-plugin": ["translators.frontseat_translation"],
+    "moos-gateway-usv-command-plugin": ["translators.command_translation"],
+    "moos-gateway-node-report-plugin": ["translators.node_report"],
+    "goby-helm-example": ["behaviors.goby_helm_example"],
+}
