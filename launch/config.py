@@ -1,0 +1,56 @@
+"""Config generation helpers shared by missions, in the manner of the Goby3 course's ``config/goby/config.py``.
+
+A mission's ``config`` module prints one application's configuration to stdout for a launch line
+(``app <(python -m launch.usv.config app)``); every value comes from one settings object, so the
+processes cannot disagree about warp, origin or ports.
+"""
+
+from __future__ import annotations
+
+import socket
+import string
+import sys
+from collections.abc import Mapping
+from pathlib import Path
+
+from launch.errors import ConfigError
+
+INVALID_BANNER = "=============== INVALID CONFIGURATION ================="
+
+
+def render(template: str | Path, values: Mapping[str, object]) -> str:
+    """Substitute ``$name`` placeholders in a template file; every placeholder must have a value."""
+    path = Path(template)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ConfigError(f"cannot read template {path}: {exc.strerror or exc}") from exc
+    try:
+        return string.Template(text).substitute({k: str(v) for k, v in values.items()})
+    except KeyError as exc:
+        raise ConfigError(f"template {path.name} needs a value for ${exc.args[0]}") from exc
+    except ValueError as exc:
+        raise ConfigError(f"template {path.name}: {exc}") from exc
+
+
+def fail(message: str) -> int:
+    """Report an invalid configuration the way the course's ``config.fail`` does; returns exit status 1.
+
+    The banner goes to stdout on purpose: it becomes the "config file" a process-substituted app reads,
+    so that app fails loudly too instead of starting on an empty configuration.
+    """
+    print(INVALID_BANNER, flush=True)
+    print(f"invalid configuration: {message}", file=sys.stderr, flush=True)
+    return 1
+
+
+def free_tcp_port(host: str = "127.0.0.1") -> int:
+    """An ephemeral TCP port that is free right now (for tests and side-by-side missions)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.bind((host, 0))
+        return int(sock.getsockname()[1])
+
+
+def text_format_string(value: str) -> str:
+    """A protobuf text-format string literal."""
+    return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'

@@ -1,0 +1,130 @@
+"""``goby-launch``: run the processes of a goby_launch launch file, like goby3's ``goby_launch -r``.
+
+Processes start in order with a delay (``-d`` ms), each with its own log file (``-L`` directory);
+the launcher reports every few seconds which are up. Ctrl-C or SIGTERM stops them in reverse order
+(the line's kill signal, then SIGKILL after ``-k`` seconds). If one dies, the launcher names it, shows
+the tail of its log, stops the rest and exits non-zero.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import signal
+import sys
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from gateway.logsetup import add_verbosity_argument, configure_logging
+from launch.errors import LaunchError, ProcessDiedError
+from launch.launchfile import parse_file
+from launch.process_group import ProcessGroup
+
+log = logging.getLogger(__name__)
+
+_UNSUPPORTED_MODES = {
+    "screen": "-s (GNU screen)",
+    "nohup": "-n (nohup)",
+    "xterm": "-x (xterm)",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="goby-launch",
+        description="Launch the processes of a goby_launch launch file; Ctrl-C stops them in reverse order.",
+    )
+    parser.add_argument("launchfile", help="one command per line, optional [kill=..., env=K=V, name=..] prefix")
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument("-r", dest="mode", action="store_const", const="normal", help="run in this terminal (default)")
+    mode.add_argument("-s", dest="mode", action="store_const", const="screen", help="not supported here")
+    mode.add_argument("-n", dest="mode", action="store_const", const="nohup", help="not supported here")
+    mode.add_argument("-x", dest="mode", action="store_const", const="xterm", help="not supported here")
+    parser.add_argument("-d", dest="delay_ms", type=float, default=10.0, help="delay between launches, ms (10)")
+    parser.add_argument("-k", dest="kill_s", type=float, default=10.0, help="SIGKILL after this many s (10)")
+    parser.add_argument("-m", dest="terminate_s", type=float, default=10.0, help="accepted for compatibility")
+    parser.add_argument("-p", dest="platform", default=None, help="platform name (default: launch file stem)")
+    parser.add_argument("-P", dest="parallel", action="store_true", help="stop all processes at once")
+    parser.add_argument("-L", dest="log_dir", default=None, help="log directory (default /tmp/goby_launch_<platform>_<time>)")
+    parser.add_argument("-b", dest="background", action="store_true", help="not supported here")
+    parser.add_argument("--status-period", type=float, default=5.0, help="seconds between status lines (5)")
+    parser.add_argument("--startup-check", type=float, default=1.0, help="seconds to watch after the last launch (1)")
+    add_verbosity_argument(parser)
+    return parser
+
+
+def child_environment() -> dict[str, str]:
+    """Our environment, with this interpreter's bin directory first on PATH.
+
+    So a launch file finds the console scripts of the same installation (``moos-db``, ``ivp-helm``, ...)
+    and ``python`` is this interpreter, even when the virtualenv is not activated.
+    """
+    env = dict(os.environ)
+    bin_dir = os.path.dirname(sys.executable)
+    path = env.get("PATH", "").split(os.pathsep)
+    if bin_dir not in path:
+        env["PATH"] = os.pathsep.join([bin_dir, *[p for p in path if p]])
+    return env
+
+
+@contextmanager
+def stop_on_signals(group: ProcessGroup) -> Iterator[None]:
+    """SIGINT and SIGTERM set the group's stop event; the previous handlers come back afterwards."""
+
+    def handler(signum: int, _frame: object) -> None:
+        group.report(f"\nReceived {signal.Signals(signum).name}")
+        group.stop_event.set()
+
+    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    configure_logging(args.verbose, "goby-launch")
+    if args.mode in _UNSUPPORTED_MODES or args.background:
+        flag = _UNSUPPORTED_MODES.get(args.mode, "-b (background)")
+        print(f"goby-launch: {flag} is not supported; processes run here with a log file each (-L)", file=sys.stderr)
+        return 2
+    try:
+        launch_file = parse_file(args.launchfile)
+    except LaunchError as exc:
+        print(f"goby-launch: {exc}", file=sys.stderr)
+        return 1
+    platform = args.platform or Path(args.launchfile).stem
+    log_dir = args.log_dir or f"/tmp/goby_launch_{platform}_{time.strftime('%Y%m%dT%H%M%S', time.gmtime())}"
+    group = ProcessGroup(
+        launch_file.entries,
+        log_dir,
+        platform=platform,
+        launch_delay_s=args.delay_ms / 1000.0,
+        kill_timeout_s=args.kill_s,
+        startup_check_s=args.startup_check,
+        base_env=child_environment(),
+        cwd=Path(args.launchfile).resolve().parent,
+        parallel_stop=args.parallel,
+    )
+    print(f"Logs in {log_dir}", flush=True)
+    with stop_on_signals(group):
+        try:
+            group.start()
+        except ProcessDiedError as exc:
+            print(f"goby-launch: failed to launch: {exc}", file=sys.stderr, flush=True)
+            return 1
+        except LaunchError as exc:
+            group.stop()
+            print(f"goby-launch: {exc}", file=sys.stderr, flush=True)
+            return 1
+        print("Use <CTRL+C> to exit", flush=True)
+        return group.supervise(status_period_s=args.status_period)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,307 @@
+"""Start launch entries as child processes, watch them, and stop them in reverse order.
+
+Each entry runs as ``bash -c "exec <command>"`` in its own session (so a terminal's Ctrl-C reaches only
+the launcher, which then stops the children in order), with stdout and stderr in one log file per
+process. Shutdown sends the entry's kill signal to the process group, waits, then escalates to SIGKILL,
+like goby_launch's ``-k``.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import re
+import signal
+import subprocess
+import threading
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO
+
+from launch.errors import LaunchError, ProcessDiedError
+from launch.launchfile import LaunchEntry, expand_vars
+
+log = logging.getLogger(__name__)
+
+Reporter = Callable[[str], None]
+_ASSIGNMENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*=")
+POLL_PERIOD_S = 0.1
+
+
+def _print(line: str) -> None:
+    print(line, flush=True)
+
+
+@dataclass
+class ManagedProcess:
+    """One launched entry: its process, log file and how it ended."""
+
+    name: str
+    entry: LaunchEntry
+    log_path: Path
+    popen: subprocess.Popen[bytes]
+    log_file: IO[bytes]
+    started_at: float = field(default_factory=time.monotonic)
+    stop_requested: bool = False
+    killed: bool = False
+    reported: bool = False
+
+    @property
+    def pid(self) -> int:
+        return self.popen.pid
+
+    @property
+    def returncode(self) -> int | None:
+        return self.popen.poll()
+
+    @property
+    def running(self) -> bool:
+        return self.popen.poll() is None
+
+    @property
+    def exited_cleanly(self) -> bool:
+        """True once it ended on its own with status 0, or on our stop signal without needing SIGKILL."""
+        code = self.popen.poll()
+        if code is None or self.killed:
+            return False
+        return code == 0 or (self.stop_requested and code == -self.entry.kill_signal)
+
+    def log_tail(self, lines: int = 20) -> str:
+        """The last lines of the process's log, for error reports."""
+        try:
+            self.log_file.flush()
+            text = self.log_path.read_text(errors="replace")
+        except OSError as exc:
+            return f"(log {self.log_path} unreadable: {exc})"
+        tail = text.splitlines()[-lines:]
+        return "\n".join(f"    {line}" for line in tail) if tail else "    (log is empty)"
+
+
+class ProcessGroup:
+    """The processes of one launch file: started in order, stopped in reverse order.
+
+    Methods are meant to be called from one thread (the launcher's main thread); ``stop_event``
+    may be set from any thread or a signal handler to interrupt start-up or supervision.
+    """
+
+    def __init__(
+        self,
+        entries: Sequence[LaunchEntry],
+        log_dir: str | Path,
+        *,
+        platform: str = "",
+        launch_delay_s: float = 0.01,
+        kill_timeout_s: float = 10.0,
+        startup_check_s: float = 1.0,
+        base_env: Mapping[str, str] | None = None,
+        cwd: str | Path | None = None,
+        parallel_stop: bool = False,
+        report: Reporter = _print,
+    ) -> None:
+        if not entries:
+            raise LaunchError("nothing to launch: the launch file has no commands")
+        self.entries = list(entries)
+        self.log_dir = Path(log_dir)
+        self.platform = platform
+        self.launch_delay_s = launch_delay_s
+        self.kill_timeout_s = kill_timeout_s
+        self.startup_check_s = startup_check_s
+        self.base_env = dict(os.environ if base_env is None else base_env)
+        self.cwd = Path(cwd) if cwd is not None else None
+        self.parallel_stop = parallel_stop
+        self.report = report
+        self.processes: list[ManagedProcess] = []
+        self.stop_event = threading.Event()
+
+    # -- start-up -------------------------------------------------------------------------------
+
+    def _unique_name(self, entry: LaunchEntry, env: Mapping[str, str]) -> str:
+        base = entry.name or os.path.basename(expand_vars(entry.binary, env)) or "process"
+        if self.platform and not entry.name:
+            base = f"{self.platform}.{base}"
+        taken = {p.name for p in self.processes}
+        name, n = base, 1
+        while name in taken:
+            n += 1
+            name = f"{base}.{n}"
+        return name
+
+    def _spawn(self, entry: LaunchEntry) -> ManagedProcess:
+        env = entry.environment(self.base_env)
+        name = self._unique_name(entry, env)
+        self.log_dir.mkdir(parents=True, exist_ok=True)
+        log_path = self.log_dir / f"{name}.log"
+        log_file = open(log_path, "wb")  # noqa: SIM115 - closed when the process is reaped
+        # `exec` makes the program itself the pid we signal; bash cannot exec an assignment prefix.
+        script = entry.command if _ASSIGNMENT.match(entry.command) else f"exec {entry.command}"
+        try:
+            popen = subprocess.Popen(
+                ["/bin/bash", "-c", script],
+                stdin=subprocess.DEVNULL,
+                stdout=log_file,
+                stderr=subprocess.STDOUT,
+                env=env,
+                cwd=self.cwd,
+                start_new_session=True,
+            )
+        except OSError as exc:
+            log_file.close()
+            raise LaunchError(f"cannot start {name!r} ({entry.command}): {exc}") from exc
+        process = ManagedProcess(name=name, entry=entry, log_path=log_path, popen=popen, log_file=log_file)
+        self.processes.append(process)
+        self.report(f"Launched ({popen.pid}) {name}: {entry.command}")
+        log.info("launched %s pid %d, log %s", name, popen.pid, log_path)
+        return process
+
+    def start(self) -> None:
+        """Launch every entry in order with the launch delay, then check that all are still up.
+
+        On a death during start-up, stops what was started and raises ProcessDiedError.
+        """
+        try:
+            for entry in self.entries:
+                if self.stop_event.is_set():
+                    return
+                self._spawn(entry)
+                self._wait_checking(self.launch_delay_s)
+            self._wait_checking(self.startup_check_s)
+        except ProcessDiedError:
+            self.stop()
+            raise
+
+    def _wait_checking(self, seconds: float) -> None:
+        deadline = time.monotonic() + seconds
+        while True:
+            died = self.check()
+            if died is not None:
+                raise ProcessDiedError(died.name, died.returncode, died.log_tail())
+            remaining = deadline - time.monotonic()
+            if remaining <= 0 or self.stop_event.wait(min(POLL_PERIOD_S, remaining)):
+                return
+
+    # -- supervision ----------------------------------------------------------------------------
+
+    def check(self) -> ManagedProcess | None:
+        """The first process that ended unexpectedly (non-zero status, not asked to stop), if any.
+
+        A process that exits with status 0 on its own has finished its job; that is reported once.
+        """
+        for process in self.processes:
+            code = process.returncode
+            if code is None or process.stop_requested or process.reported:
+                continue
+            process.reported = True
+            if code == 0:
+                self.report(f"[{self.platform}] {time.strftime('%H:%M:%S')}: {process.name} finished")
+                continue
+            return process
+        return None
+
+    def running(self) -> list[ManagedProcess]:
+        return [p for p in self.processes if p.running]
+
+    def supervise(self, status_period_s: float = 5.0) -> int:
+        """Watch the processes until stop_event is set, one dies, or all finish; then stop them all.
+
+        Returns the exit status for the launcher: 0 after a requested stop or when every process
+        finished cleanly, 1 when a process died (named in the report with the tail of its log).
+        """
+        next_status = time.monotonic()
+        status = 0
+        try:
+            while not self.stop_event.is_set():
+                died = self.check()
+                if died is not None:
+                    self.report(
+                        f"[{self.platform}] {time.strftime('%H:%M:%S')}: {died.name} died unexpectedly "
+                        f"(exit status {died.returncode}); stopping the others. Last lines of "
+                        f"{died.log_path}:\n{died.log_tail()}"
+                    )
+                    status = 1
+                    break
+                if not self.running():
+                    self.report(f"[{self.platform}]: All processes exited")
+                    break
+                if time.monotonic() >= next_status:
+                    self._report_status()
+                    next_status = time.monotonic() + status_period_s
+                self.stop_event.wait(POLL_PERIOD_S)
+        finally:
+            self.stop()
+        return status
+
+    def _report_status(self) -> None:
+        stamp = time.strftime("%H:%M:%S")
+        running = self.running()
+        if len(running) == len(self.processes):
+            self.report(f"[{self.platform}] {stamp}: All processes running ({len(running)})")
+            return
+        for process in self.processes:
+            if not process.running:
+                self.report(f"[{self.platform}] {stamp}: Missing PID: {process.pid} (was: {process.name})")
+
+    # -- shutdown -------------------------------------------------------------------------------
+
+    def _signal(self, process: ManagedProcess, sig: signal.Signals) -> None:
+        try:
+            os.killpg(process.pid, sig)
+        except ProcessLookupError:
+            pass
+        except PermissionError:
+            process.popen.send_signal(sig)
+
+    def _wait_or_kill(self, processes: Sequence[ManagedProcess]) -> None:
+        deadline = time.monotonic() + self.kill_timeout_s
+        for process in processes:
+            try:
+                process.popen.wait(timeout=max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                self.report(
+                    f"WARNING: {process.name} ({process.pid}) did not respond to "
+                    f"{process.entry.kill_signal.name} after {self.kill_timeout_s:g} s, sending SIGKILL"
+                )
+                process.killed = True
+                self._signal(process, signal.SIGKILL)
+                process.popen.wait()
+            else:
+                # The program is gone; make sure helpers left in its group (process substitution) go too.
+                self._signal(process, signal.SIGKILL)
+            self._close(process)
+
+    def _close(self, process: ManagedProcess) -> None:
+        if not process.log_file.closed:
+            process.log_file.close()
+
+    def stop(self) -> None:
+        """Stop every running process (reverse launch order, or all at once if parallel_stop)."""
+        order = list(reversed(self.processes))
+        for process in order:
+            if not process.running:
+                process.popen.wait()
+                self._close(process)
+        live = [p for p in order if p.running]
+        if not live:
+            return
+        self.report("Cleaning up...")
+        if self.parallel_stop:
+            for process in live:
+                process.stop_requested = True
+                self._signal(process, process.entry.kill_signal)
+            self._wait_or_kill(live)
+        else:
+            for process in live:
+                process.stop_requested = True
+                self.report(f"{process.entry.kill_signal.name}: {process.pid} (was {process.name})")
+                self._signal(process, process.entry.kill_signal)
+                self._wait_or_kill([process])
+        for process in live:
+            verdict = "success" if process.exited_cleanly else f"exit status {process.returncode}"
+            log.info("%s stopped: %s", process.name, verdict)
+
+    def __enter__(self) -> ProcessGroup:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()

@@ -1,0 +1,106 @@
+"""``python -m launch.usv.config APP``: print one USV application's configuration (the course's usv.pb.cfg.py).
+
+Goby-style apps get protobuf text format (read through bash process substitution, ``app <(...)``);
+``frontseat_sim`` prints the simulator's port; ``moos`` writes the .moos mission file into the run
+directory and prints its path, because MOOS applications read their file more than once and cannot
+use process substitution. All values come from ``UsvSettings.from_env()``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+from launch.config import fail, render
+from launch.errors import ConfigError
+from launch.usv.settings import USV_DIR, UsvSettings
+
+TEMPLATES = USV_DIR / "templates"
+
+
+def _values(settings: UsvSettings, app: str) -> dict[str, object]:
+    values: dict[str, object] = {
+        "app": app,
+        "warp": settings.warp,
+        "lat_origin": repr(settings.lat_origin),
+        "lon_origin": repr(settings.lon_origin),
+        "platform": settings.platform,
+        "socket_name": settings.ipc_base,
+        "moos_host": "127.0.0.1",
+        "moos_port": settings.moos_port,
+        "sim_port": settings.sim_port,
+        "community": settings.community,
+        "vehicle_id": settings.vehicle_id,
+        "bhv_file": settings.bhv_file,
+    }
+    values["app_block"] = render(TEMPLATES / "_app.pb.cfg.in", values)
+    values["interprocess_block"] = render(TEMPLATES / "_interprocess.pb.cfg.in", values)
+    return values
+
+
+def _pb(template: str, app: str) -> Callable[[UsvSettings], str]:
+    def generate(settings: UsvSettings) -> str:
+        return render(TEMPLATES / template, _values(settings, app))
+
+    return generate
+
+
+def moos_file_text(settings: UsvSettings) -> str:
+    """The .moos mission file's text (globals shared with the Goby side, the helm's ProcessConfig)."""
+    return render(TEMPLATES / "usv.moos.in", _values(settings, "moos"))
+
+
+def write_moos_file(settings: UsvSettings) -> Path:
+    """Write the .moos file atomically (several launch lines may generate it at once); return its path."""
+    path = settings.moos_file
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".moos-", suffix=".tmp")
+    with os.fdopen(fd, "w") as out:
+        out.write(moos_file_text(settings))
+    os.replace(tmp, path)
+    return path
+
+
+def _moos(settings: UsvSettings) -> str:
+    if not settings.bhv_file.is_file():
+        raise ConfigError(f"behaviour file {settings.bhv_file} does not exist (USV_BHV_FILE)")
+    return str(write_moos_file(settings))
+
+
+GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
+    "broker": _pb("broker.pb.cfg.in", "goby-broker"),
+    "frontseat_sim": lambda s: str(s.sim_port),
+    "frontseat_interface": _pb("frontseat_interface.pb.cfg.in", "frontseat-interface"),
+    "moos_gateway": _pb("moos_gateway.pb.cfg.in", "moos-gateway"),
+    "usv_manager": _pb("usv_manager.pb.cfg.in", "usv-manager"),
+    "shore": _pb("shore.pb.cfg.in", "usv-shore"),
+    "moos": _moos,
+}
+
+
+def generate(app: str, settings: UsvSettings) -> str:
+    """One app's configuration text; ConfigError for an unknown app or a bad setting."""
+    try:
+        generator = GENERATORS[app]
+    except KeyError:
+        raise ConfigError(f"App: {app} not defined (known: {', '.join(sorted(GENERATORS))})") from None
+    return generator(settings)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    if len(args) != 1:
+        return fail(f"usage: python -m launch.usv.config APP   (APP one of {', '.join(sorted(GENERATORS))})")
+    try:
+        text = generate(args[0], UsvSettings.from_env())
+    except ConfigError as exc:
+        return fail(str(exc))
+    print(text, flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,116 @@
+"""The USV mission's settings, in one place: every generated config reads them from here.
+
+Settings travel to the launch lines as ``USV_*`` environment variables (see ``to_env``/``from_env``),
+the way the course passes ``goby3_course_n_auvs``; the config generator run by each line rebuilds
+the same ``UsvSettings`` from them. Defaults follow the course: vehicle id 1, MOOS port 9000+id,
+simulator port 55000+id, the Kauai origin, platform ``usv``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from launch.errors import ConfigError
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+USV_DIR = Path(__file__).resolve().parent
+KAUAI_ORIGIN = (21.590491, -159.534166)
+BUZZARDS_BAY_ORIGIN = (41.592344, -70.711260)
+
+# The shore script's default plan: (sim seconds after the vehicle is under helm command, command).
+DEFAULT_SCHEDULE = "0:polygon:6:200,500:waypoints,800:polygon:8:400"
+
+_ENV = {
+    "run_dir": "USV_RUN_DIR",
+    "warp": "USV_WARP",
+    "lat_origin": "USV_LAT_ORIGIN",
+    "lon_origin": "USV_LON_ORIGIN",
+    "platform": "USV_PLATFORM",
+    "community": "USV_COMMUNITY",
+    "vehicle_id": "USV_VEHICLE_ID",
+    "moos_port": "USV_MOOS_PORT",
+    "sim_port": "USV_SIM_PORT",
+    "moosdb": "USV_MOOSDB",
+    "helm": "USV_HELM",
+    "bhv_file": "USV_BHV_FILE",
+    "schedule": "USV_SHORE_SCHEDULE",
+    "socket_name": "USV_SOCKET_NAME",
+}
+
+
+@dataclass(frozen=True)
+class UsvSettings:
+    """Everything two processes must agree on: time warp, origin, ports, names, file places."""
+
+    run_dir: Path = Path("/tmp/usv_mission")
+    warp: int = 20
+    lat_origin: float = KAUAI_ORIGIN[0]
+    lon_origin: float = KAUAI_ORIGIN[1]
+    platform: str = "usv"
+    community: str = "usv"
+    vehicle_id: int = 1
+    moos_port: int = 9001
+    sim_port: int = 55001
+    moosdb: str = "moos-db"
+    helm: str = "ivp-helm"
+    bhv_file: Path = REPO_ROOT / "behaviors" / "usv.bhv"
+    schedule: str = DEFAULT_SCHEDULE
+    socket_name: str = ""
+
+    def __post_init__(self) -> None:
+        if self.warp < 1:
+            raise ConfigError(f"warp must be a whole number >= 1, not {self.warp}")
+        for port_name in ("moos_port", "sim_port"):
+            port = getattr(self, port_name)
+            if not 0 < port < 65536:
+                raise ConfigError(f"{port_name} {port} is not a TCP port")
+        if not -90 <= self.lat_origin <= 90 or not -180 <= self.lon_origin <= 180:
+            raise ConfigError(f"origin {self.lat_origin},{self.lon_origin} is not a latitude,longitude")
+
+    @property
+    def ipc_base(self) -> str:
+        """The broker's IPC socket base (``<base>.manager``, ``.xpub``, ``.xsub``), short enough for AF_UNIX."""
+        return self.socket_name or str(self.run_dir / f"goby_{self.platform}")
+
+    @property
+    def moos_file(self) -> Path:
+        return self.run_dir / f"{self.platform}.moos"
+
+    @property
+    def log_dir(self) -> Path:
+        return self.run_dir / "logs"
+
+    def to_env(self) -> dict[str, str]:
+        """The ``USV_*`` environment variables that reproduce these settings in a launch line."""
+        return {var: str(getattr(self, field)) for field, var in _ENV.items()}
+
+    @classmethod
+    def from_env(cls, environ: Mapping[str, str] | None = None) -> UsvSettings:
+        """Settings from ``USV_*`` variables; unset ones keep the defaults. Bad values raise ConfigError."""
+        environ = os.environ if environ is None else environ
+        kwargs: dict[str, object] = {}
+        types = {f.name: f.type for f in dataclasses.fields(cls)}
+        for field, var in _ENV.items():
+            raw = environ.get(var)
+            if raw is None or raw == "":
+                continue
+            kind = types[field]
+            try:
+                if kind in ("int", int):
+                    kwargs[field] = int(raw)
+                elif kind in ("float", float):
+                    kwargs[field] = float(raw)
+                elif kind in ("Path", Path):
+                    kwargs[field] = Path(raw)
+                else:
+                    kwargs[field] = raw
+            except ValueError as exc:
+                raise ConfigError(f"{var}={raw!r} is not a valid {kind}") from exc
+        return cls(**kwargs)  # type: ignore[arg-type]
+
+    def replace(self, **changes: object) -> UsvSettings:
+        return dataclasses.replace(self, **changes)  # type: ignore[arg-type]

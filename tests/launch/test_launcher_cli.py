@@ -1,0 +1,202 @@
+"""goby-launch as a user runs it: real child processes, real signals, real log files."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+# A child that records the signal it got in its log, so the test can see the shutdown order.
+CHILD = textwrap.dedent(
+    """
+    import signal, sys, time
+    name = sys.argv[1]
+    def bye(signum, frame):
+        print(f"{name} got {signal.Signals(signum).name} at {time.monotonic():.6f}", flush=True)
+        sys.exit(0)
+    signal.signal(signal.SIGTERM, bye)
+    signal.signal(signal.SIGINT, bye)
+    print(f"{name} up", flush=True)
+    while True:
+        time.sleep(0.05)
+    """
+)
+
+
+class LauncherRun:
+    """goby-launch in a child process, its output collected by a reader thread (joined in finish())."""
+
+    def __init__(self, launch_file: Path, log_dir: Path, *extra: str) -> None:
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "launch.launcher", "-d", "50", "--status-period", "0.5", "-L", str(log_dir),
+             *extra, str(launch_file)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        self.lines: list[str] = []
+        self.reader = threading.Thread(target=self._read, name="launcher-output", daemon=True)
+        self.reader.start()
+
+    def _read(self) -> None:
+        for line in self.proc.stdout:
+            self.lines.append(line)
+
+    @property
+    def output(self) -> str:
+        return "".join(self.lines)
+
+    def wait_for_output(self, text: str, timeout: float = 60.0) -> None:
+        _wait_for(lambda: text in self.output, timeout, what=repr(text))
+
+    def finish(self, timeout: float = 60.0) -> str:
+        try:
+            self.proc.wait(timeout=timeout)
+        finally:
+            if self.proc.poll() is None:
+                self.proc.kill()
+                self.proc.wait()
+            self.reader.join(timeout=10)
+        return self.output
+
+
+def _wait_for(predicate, timeout: float = 60.0, what: str = "condition") -> None:
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what}")
+        time.sleep(0.05)
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    stat = Path(f"/proc/{pid}/stat")
+    try:
+        return stat.read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def _launched_pids(output: str) -> list[int]:
+    return [int(p) for p in re.findall(r"^Launched \((\d+)\)", output, flags=re.M)]
+
+
+@pytest.fixture
+def child_script(tmp_path: Path) -> Path:
+    path = tmp_path / "child.py"
+    path.write_text(CHILD)
+    return path
+
+
+def test_starts_in_order_and_stops_in_reverse_on_sigint(tmp_path, child_script):
+    launch_file = tmp_path / "three.launch"
+    launch_file.write_text(
+        f"# three children\n"
+        f"[name=first] {sys.executable} {child_script} first\n"
+        f"[name=second, env=GREETING=hello] bash -c 'echo $GREETING; cat <(echo substituted); "
+        f"exec {sys.executable} {child_script} second'\n"
+        f"[name=third, kill=SIGINT] {sys.executable} {child_script} third\n"
+    )
+    logs = tmp_path / "logs"
+    run = LauncherRun(launch_file, logs)
+    try:
+        run.wait_for_output("All processes running (3)")
+        _wait_for(lambda: all("up" in (logs / f"{n}.log").read_text() for n in ("first", "second", "third")),
+                  what="all three children up")
+        run.proc.send_signal(signal.SIGINT)
+    finally:
+        output = run.finish()
+    assert run.proc.returncode == 0, output
+    second_log = (logs / "second.log").read_text()
+    assert "hello" in second_log and "substituted" in second_log
+    stamps = {}
+    for name, sig in (("first", "SIGTERM"), ("second", "SIGTERM"), ("third", "SIGINT")):
+        match = re.search(rf"{name} got {sig} at ([0-9.]+)", (logs / f"{name}.log").read_text())
+        assert match, f"{name} did not get {sig}"
+        stamps[name] = float(match.group(1))
+    assert stamps["third"] < stamps["second"] < stamps["first"], stamps
+    assert all(not _pid_alive(pid) for pid in _launched_pids(output))
+
+
+def test_a_dying_process_is_named_with_its_log_tail_and_the_rest_are_stopped(tmp_path, child_script):
+    launch_file = tmp_path / "dies.launch"
+    launch_file.write_text(
+        f"[name=survivor] {sys.executable} {child_script} survivor\n"
+        f"[name=doomed] bash -c 'sleep 2; echo boom: cannot reach the MOOSDB >&2; exit 3'\n"
+    )
+    logs = tmp_path / "logs"
+    run = LauncherRun(launch_file, logs)
+    output = run.finish()
+    assert run.proc.returncode == 1, output
+    assert "doomed died unexpectedly (exit status 3)" in output
+    assert "boom: cannot reach the MOOSDB" in output
+    assert "survivor got SIGTERM" in (logs / "survivor.log").read_text()
+    assert all(not _pid_alive(pid) for pid in _launched_pids(output))
+
+
+def test_death_during_startup_fails_the_launch(tmp_path, child_script):
+    launch_file = tmp_path / "bad.launch"
+    launch_file.write_text(
+        f"[name=ok] {sys.executable} {child_script} ok\n"
+        "[name=missing] no-such-program-xyz --flag\n"
+    )
+    run = LauncherRun(launch_file, tmp_path / "logs")
+    output = run.finish()
+    assert run.proc.returncode == 1
+    assert "failed to launch" in output and "'missing'" in output
+    assert "no-such-program-xyz" in output  # bash's "not found" from the log tail
+    assert all(not _pid_alive(pid) for pid in _launched_pids(output))
+
+
+def test_sigkill_after_the_kill_timeout(tmp_path):
+    launch_file = tmp_path / "stubborn.launch"
+    launch_file.write_text("[name=stubborn] bash -c 'trap \"echo ignoring TERM\" TERM; while true; do sleep 0.1; done'\n")
+    logs = tmp_path / "logs"
+    run = LauncherRun(launch_file, logs, "-k", "1")
+    try:
+        run.wait_for_output("All processes running")
+        started = time.monotonic()
+        run.proc.send_signal(signal.SIGTERM)
+    finally:
+        output = run.finish()
+    assert "did not respond to SIGTERM after 1 s, sending SIGKILL" in output
+    assert time.monotonic() - started >= 1.0
+    assert "ignoring TERM" in (logs / "stubborn.log").read_text()
+
+
+@pytest.mark.parametrize(
+    ("content", "flag", "message"),
+    [
+        ("[kill=SIGUSR1] sleep 5\n", None, "invalid kill=SIGUSR1"),
+        ("# nothing\n", None, "no commands to launch"),
+        ("sleep 5\n", "-s", "-s (GNU screen) is not supported"),
+    ],
+)
+def test_bad_launch_files_and_options_exit_non_zero_with_the_cause(tmp_path, content, flag, message):
+    launch_file = tmp_path / "x.launch"
+    launch_file.write_text(content)
+    args = [sys.executable, "-m", "launch.launcher", *([flag] if flag else []), str(launch_file)]
+    result = subprocess.run(args, capture_output=True, text=True, timeout=60)
+    assert result.returncode != 0
+    assert message in result.stderr
+
+
+def test_a_process_that_finishes_with_status_zero_is_not_a_failure(tmp_path):
+    launch_file = tmp_path / "oneshot.launch"
+    launch_file.write_text("[name=oneshot] bash -c 'sleep 1.5; echo done'\n")
+    run = LauncherRun(launch_file, tmp_path / "logs")
+    output = run.finish()
+    assert run.proc.returncode == 0, output
+    assert "oneshot finished" in output
+    assert "All processes exited" in output
