@@ -1,0 +1,71 @@
+"""MOOS v10 in pure Python: wire codec, a pymoos-compatible client (``comms``), a MOOSDB-compatible server,
+``.moos`` mission files, and the ``moos-db`` / ``moos-poke`` / ``moos-scope`` tools.
+
+``from gateway.moos import comms`` is a drop-in for ``import pymoos; pymoos.comms``. To use the real pymoos
+when it is importable, call :func:`make_comms` (or set ``GOBY_MOOS_CLIENT=pymoos``).
+"""
+
+from __future__ import annotations
+
+from .client import comms
+from .clock import DEFAULT_CLOCK, MoosClock
+from .errors import (
+    ConnectionClosedError,
+    HandshakeError,
+    MissionFileError,
+    MoosError,
+    NotConnectedError,
+    PoisonedError,
+    ProtocolError,
+)
+from .factory import make_comms
+from .message import MoosMessage
+
+moos_msg = MoosMessage  # pymoos's name for the message class
+
+
+def time(apply_timewarping: bool = True) -> float:
+    """MOOS time (warped unix time plus the skew learned from the DB), as ``pymoos.time()``."""
+    return DEFAULT_CLOCK.time(apply_timewarping)
+
+
+def local_time(apply_timewarping: bool = True) -> float:
+    """Warped unix time without skew, as ``pymoos.local_time()``."""
+    return DEFAULT_CLOCK.local_time(apply_timewarping)
+
+
+def set_moos_timewarp(warp: float) -> None:
+    """Set the process-wide time warp used by :func:`time` and by clients built without their own clock."""
+    DEFAULT_CLOCK.set_warp(warp)
+
+
+def get_moos_timewarp() -> float:
+    return DEFAULT_CLOCK.warp
+
+
+def is_little_end_in() -> bool:
+    """pymoos's (misspelled) byte-order query; MOOS is little-endian on the wire whatever the host."""
+    import sys
+
+    return sys.byteorder == "little"
+
+
+__all__ = [
+    "ConnectionClosedError",
+    "HandshakeError",
+    "MissionFileError",
+    "MoosClock",
+    "MoosError",
+    "MoosMessage",
+    "NotConnectedError",
+    "PoisonedError",
+    "ProtocolError",
+    "comms",
+    "get_moos_timewarp",
+    "is_little_end_in",
+    "local_time",
+    "make_comms",
+    "moos_msg",
+    "set_moos_timewarp",
+    "time",
+]

@@ -1,0 +1,476 @@
+"""``MoosDB``: a MOOSDB-compatible server on one selector-driven I/O thread.
+
+One thread accepts, handshakes, reads, runs the database and writes, so packets from all clients are
+processed one at a time in arrival order (as the C++ central server thread does) without locks. Sockets are
+non-blocking; each connection has its own output queue. If a client stops reading and its queue passes
+``high_water`` bytes, the server stops reading from everyone (TCP then slows the senders down) until it
+drains; a client that makes no progress for ``stall_timeout`` seconds is dropped with a logged reason.
+Any client that sends bad bytes is dropped alone, with the reason logged; the others carry on.
+"""
+
+from __future__ import annotations
+
+import logging
+import selectors
+import socket
+import threading
+import time as _time
+from collections import deque
+
+from .clock import MoosClock
+from .codec import (
+    DEFAULT_MAX_PACKET_BYTES,
+    PROTOCOL_STRING,
+    PROTOCOL_STRING_SIZE,
+    PacketReader,
+    encode_message,
+    frame_packet,
+)
+from .database import MoosDatabase
+from .errors import MoosError, ProtocolError
+from .message import (
+    ASYNC_KEY,
+    DATA,
+    DOUBLE,
+    NULL_MSG,
+    POISON,
+    STRING,
+    TIMING,
+    WELCOME,
+    MoosMessage,
+    to_bytes,
+    to_str,
+)
+
+log = logging.getLogger(__name__)
+
+HANDSHAKE_TIMEOUT_S = 5.0
+RECV_BYTES = 256 * 1024
+HIGH_WATER = 4 * 1024 * 1024
+LOW_WATER = 1024 * 1024
+SEND_CHUNK = 1024 * 1024
+
+_PROTOCOL, _HELLO, _READY, _CLOSED = range(4)
+
+
+class _Client:
+    """One accepted connection and its state."""
+
+    __slots__ = ("sock", "peer", "state", "proto_buf", "reader", "name", "asynchronous", "last_rx", "accepted",
+                 "out", "out_bytes", "last_progress", "events")
+
+    def __init__(self, sock: socket.socket, peer: str, max_packet_bytes: int) -> None:
+        self.sock = sock
+        self.peer = peer
+        self.state = _PROTOCOL
+        self.proto_buf = b""
+        self.reader = PacketReader(max_packet_bytes)
+        self.name = b""
+        self.asynchronous = False
+        self.accepted = self.last_rx = self.last_progress = _time.monotonic()
+        self.out: deque[bytes] = deque()
+        self.out_bytes = 0
+        self.events = 0
+
+    def label(self) -> str:
+        return f"{to_str(self.name)!r} ({self.peer})" if self.name else self.peer
+
+
+class MoosDB:
+    """A MOOSDB. ``start()`` binds (``port=0`` picks a free port, see ``.port``) and serves on a thread."""
+
+    def __init__(
+        self,
+        host: str = "127.0.0.1",
+        port: int = 0,
+        community: str = "moos",
+        time_warp: float = 1.0,
+        client_timeout: float = 5.0,
+        max_packet_bytes: int = DEFAULT_MAX_PACKET_BYTES,
+        stall_timeout: float = 6.0,
+    ) -> None:
+        self.host = host
+        self._requested_port = int(port)
+        self.community = community
+        self.clock = MoosClock(time_warp)
+        self.client_timeout = float(client_timeout)
+        self.stall_timeout = float(stall_timeout)
+        self.max_packet_bytes = max_packet_bytes
+        self.db = MoosDatabase(community, self.clock)
+        self._hostname = to_bytes(socket.gethostname())
+        self._listener: socket.socket | None = None
+        self._selector: selectors.BaseSelector | None = None
+        self._wake_r: socket.socket | None = None
+        self._wake_w: socket.socket | None = None
+        self._thread: threading.Thread | None = None
+        self._stopping = threading.Event()
+        self._clients: dict[int, _Client] = {}
+        self._by_name: dict[bytes, _Client] = {}
+        self._paused = False
+        self._congested: set[_Client] = set()
+        self._lock = threading.Lock()
+        self.port = 0
+        self.dropped: list[tuple[str, str]] = []  # (client, reason) for every client dropped for a fault
+
+    # ---- lifecycle ---------------------------------------------------------------------------------
+    def start(self) -> MoosDB:
+        """Bind and start serving; returns self. Raises OSError if the port is taken."""
+        if self._thread is not None:
+            return self
+        listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            listener.bind((self.host, self._requested_port))
+            listener.listen(50)
+        except OSError:
+            listener.close()
+            raise
+        listener.setblocking(False)
+        self._listener = listener
+        self.port = listener.getsockname()[1]
+        self._selector = selectors.DefaultSelector()
+        self._wake_r, self._wake_w = socket.socketpair()
+        self._wake_r.setblocking(False)
+        self._selector.register(listener, selectors.EVENT_READ, None)
+        self._selector.register(self._wake_r, selectors.EVENT_READ, None)
+        self._stopping.clear()
+        self._thread = threading.Thread(target=self._loop, name=f"moosdb-{self.port}", daemon=True)
+        self._thread.start()
+        log.info("MOOSDB %s serving on %s:%d (warp %g)", self.community, self.host, self.port, self.clock.warp)
+        return self
+
+    def stop(self) -> None:
+        """Close every connection and the listening socket, and end the thread; idempotent."""
+        thread = self._thread
+        if thread is None:
+            return
+        self._stopping.set()
+        try:
+            self._wake_w.send(b"x")  # type: ignore[union-attr]
+        except OSError:
+            pass
+        if thread is not threading.current_thread():
+            thread.join(10.0)
+        self._thread = None
+
+    def __enter__(self) -> MoosDB:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def serve_forever(self) -> None:
+        """Block until :meth:`stop` is called from elsewhere (a signal handler, another thread)."""
+        while self._thread is not None and self._thread.is_alive():
+            self._thread.join(0.5)
+
+    @property
+    def address(self) -> tuple[str, int]:
+        return self.host, self.port
+
+    def client_names(self) -> list[str]:
+        """Names of the clients that completed the handshake, in connection order."""
+        with self._lock:
+            return [to_str(name) for name in self._by_name]
+
+    # ---- the loop ----------------------------------------------------------------------------------
+    def _loop(self) -> None:
+        sel = self._selector
+        assert sel is not None
+        next_check = _time.monotonic() + 0.25
+        try:
+            while not self._stopping.is_set():
+                for key, mask in sel.select(timeout=0.25):
+                    obj = key.fileobj
+                    if obj is self._listener:
+                        self._accept()
+                    elif obj is self._wake_r:
+                        try:
+                            self._wake_r.recv(64)  # type: ignore[union-attr]
+                        except OSError:
+                            pass
+                    else:
+                        client = key.data
+                        if mask & selectors.EVENT_WRITE and client.state != _CLOSED:
+                            self._flush(client)
+                        if mask & selectors.EVENT_READ and client.state != _CLOSED:
+                            self._read(client)
+                self._push_waiting_mail()
+                now = _time.monotonic()
+                if now >= next_check:
+                    next_check = now + 0.25
+                    self._check_timeouts(now)
+        except Exception:
+            log.exception("MOOSDB I/O loop failed")
+        finally:
+            self._shutdown()
+
+    def _shutdown(self) -> None:
+        for client in list(self._clients.values()):
+            self._close(client, None)
+        for sock in (self._listener, self._wake_r, self._wake_w):
+            if sock is not None:
+                try:
+                    sock.close()
+                except OSError:
+                    pass
+        if self._selector is not None:
+            self._selector.close()
+        log.info("MOOSDB %s on port %d stopped", self.community, self.port)
+
+    def _accept(self) -> None:
+        try:
+            sock, addr = self._listener.accept()  # type: ignore[union-attr]
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError as exc:
+            log.warning("accept failed: %s", exc)
+            return
+        sock.setblocking(False)
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        client = _Client(sock, f"{addr[0]}:{addr[1]}", self.max_packet_bytes)
+        self._clients[sock.fileno()] = client
+        self._set_events(client)
+        log.debug("accepted a connection from %s", client.peer)
+
+    def _set_events(self, client: _Client) -> None:
+        want = (0 if self._paused else selectors.EVENT_READ) | (selectors.EVENT_WRITE if client.out else 0)
+        if want == client.events or client.state == _CLOSED:
+            return
+        sel = self._selector
+        assert sel is not None
+        if client.events == 0:
+            sel.register(client.sock, want, client)
+        elif want == 0:
+            sel.unregister(client.sock)
+        else:
+            sel.modify(client.sock, want, client)
+        client.events = want
+
+    # ---- reading -----------------------------------------------------------------------------------
+    def _read(self, client: _Client) -> None:
+        try:
+            data = client.sock.recv(RECV_BYTES)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError as exc:
+            self._close(client, f"read failed: {exc}", fault=False)
+            return
+        if not data:
+            self._close(client, "closed the connection", fault=False)
+            return
+        client.last_rx = _time.monotonic()
+        if client.state == _PROTOCOL:
+            need = PROTOCOL_STRING_SIZE - len(client.proto_buf)
+            client.proto_buf += data[:need]
+            data = data[need:]
+            if len(client.proto_buf) < PROTOCOL_STRING_SIZE:
+                return
+            offered = client.proto_buf.split(b"\0", 1)[0]
+            if offered.lower() != PROTOCOL_STRING.lower():
+                self._close(client, f"incompatible wire protocol: sent {offered[:40]!r}, expected {PROTOCOL_STRING!r}")
+                return
+            client.state = _HELLO
+            if not data:
+                return
+        try:
+            packets = client.reader.feed(data)
+        except ProtocolError as exc:
+            for packet in exc.packets:
+                if client.state == _CLOSED or not self._on_packet(client, packet):
+                    return
+            self._close(client, f"malformed packet: {exc}")
+            return
+        for packet in packets:
+            if client.state == _CLOSED or not self._on_packet(client, packet):
+                return
+
+    def _on_packet(self, client: _Client, packet: list[MoosMessage]) -> bool:
+        if client.state == _HELLO:
+            return self._handshake(client, packet)
+        try:
+            self._process(client, packet)
+        except MoosError as exc:
+            self._close(client, str(exc))
+            return False
+        return client.state != _CLOSED
+
+    def _handshake(self, client: _Client, packet: list[MoosMessage]) -> bool:
+        """The client's first packet names it: POISON a duplicate or empty name, else WELCOME."""
+        if not packet:
+            return self._poison(client, "Failed to read receive client's name")
+        hello = packet[0]
+        name = hello.raw_sval
+        if hello.msg_type != DATA:
+            return self._poison(client, f"expected a MOOS_DATA handshake message, got type {hello.type()!r}")
+        if not name:
+            return self._poison(client, "Failed to read receive client's name (empty)")
+        if name in self._by_name:
+            return self._poison(client, f'A client of this name ("{to_str(name)}") already exists')
+        now = self.clock.time()
+        welcome = MoosMessage(
+            WELCOME, DOUBLE, aux=b"hostname=" + self._hostname, community=self.db.community,
+            msg_time=now, dval=now - hello.msg_time, sval=ASYNC_KEY,
+        )
+        client.name = name
+        client.asynchronous = hello.raw_key.lower() == ASYNC_KEY
+        client.state = _READY
+        with self._lock:
+            self._by_name[name] = client
+        self._send(client, frame_packet([encode_message(welcome)]))
+        self.db.connect(name, client.asynchronous)
+        log.info("client %s connected (%s)", client.label(), "asynchronous" if client.asynchronous else "synchronous")
+        return client.state != _CLOSED
+
+    def _poison(self, client: _Client, reason: str) -> bool:
+        poison = MoosMessage(POISON, STRING, msg_time=self.clock.time(), sval=to_bytes(reason))
+        self._send(client, frame_packet([encode_message(poison)]))
+        self._flush(client)
+        self._close(client, f"refused: {reason}")
+        return False
+
+    def _process(self, client: _Client, packet: list[MoosMessage]) -> None:
+        """One packet through the DB; reply as the ThreadedCommServer does for sync and async clients."""
+        db = self.db
+        timing = None
+        if packet and packet[0].msg_type == TIMING:
+            timing = packet.pop(0)
+            now_local = self.clock.local_time()
+            db.record_timing(client.name, (now_local - timing.msg_time) * 1000.0 / self.clock.warp)
+            timing.dval = now_local
+            timing.dval2 = 0.0
+        replies, _ = db.process(packet)
+        out: list[bytes] = []
+        if not client.asynchronous:
+            out.append(encode_message(MoosMessage(NULL_MSG, DOUBLE, dval=self.clock.local_time())))
+        elif timing is not None:
+            out.append(encode_message(timing))
+        if packet or not client.asynchronous:
+            out.extend(db.take_mail(client.name))
+            out.extend(encode_message(m) for m in replies)
+        if out:
+            self._send(client, frame_packet(out))
+
+    def _push_waiting_mail(self) -> None:
+        """Asynchronous clients get their held mail pushed without asking (sync clients wait for their poll)."""
+        db = self.db
+        if not db.mail_waiting:
+            return
+        for name in list(db.mail_waiting):
+            client = self._by_name.get(name)
+            if client is None:
+                db.mail_waiting.discard(name)
+            elif client.asynchronous:
+                mail = db.take_mail(name)
+                if mail:
+                    self._send(client, frame_packet(mail))
+
+    # ---- writing -----------------------------------------------------------------------------------
+    def _send(self, client: _Client, data: bytes) -> None:
+        if client.state == _CLOSED:
+            return
+        if not client.out:
+            try:
+                sent = client.sock.send(data)
+            except (BlockingIOError, InterruptedError):
+                sent = 0
+            except OSError as exc:
+                self._close(client, f"write failed: {exc}", fault=False)
+                return
+            if sent == len(data):
+                return
+            data = data[sent:]
+            client.last_progress = _time.monotonic()
+        client.out.append(data)
+        client.out_bytes += len(data)
+        self._set_events(client)
+        if client.out_bytes > HIGH_WATER and client not in self._congested:
+            self._congested.add(client)
+            log.warning("client %s is not keeping up (%d bytes queued); pausing reads from all clients",
+                        client.label(), client.out_bytes)
+            self._set_paused(True)
+
+    def _flush(self, client: _Client) -> None:
+        while client.out:
+            chunk = client.out[0]
+            if len(client.out) > 1 and len(chunk) < SEND_CHUNK:
+                parts = []
+                size = 0
+                while client.out and size < SEND_CHUNK:
+                    part = client.out.popleft()
+                    parts.append(part)
+                    size += len(part)
+                chunk = b"".join(parts)
+                client.out.appendleft(chunk)
+            try:
+                sent = client.sock.send(chunk)
+            except (BlockingIOError, InterruptedError):
+                break
+            except OSError as exc:
+                self._close(client, f"write failed: {exc}", fault=False)
+                return
+            client.last_progress = _time.monotonic()
+            client.out_bytes -= sent
+            if sent < len(chunk):
+                client.out[0] = chunk[sent:]
+                break
+            client.out.popleft()
+        if client in self._congested and client.out_bytes < LOW_WATER:
+            self._congested.discard(client)
+            if not self._congested:
+                self._set_paused(False)
+        self._set_events(client)
+
+    def _set_paused(self, paused: bool) -> None:
+        if paused == self._paused:
+            return
+        self._paused = paused
+        now = _time.monotonic()
+        for client in list(self._clients.values()):
+            if not paused:
+                client.last_rx = now  # silence while we were not reading is not the client's fault
+            self._set_events(client)
+        if not paused:
+            log.info("output queues drained; reading from clients again")
+
+    # ---- timeouts and closing ----------------------------------------------------------------------
+    def _check_timeouts(self, now: float) -> None:
+        for client in list(self._clients.values()):
+            if client.state in (_PROTOCOL, _HELLO):
+                if now - client.accepted > HANDSHAKE_TIMEOUT_S:
+                    self._close(client, f"no handshake within {HANDSHAKE_TIMEOUT_S:g} s")
+            elif client.out_bytes and now - client.last_progress > self.stall_timeout:
+                self._close(client, f"not reading: {client.out_bytes} bytes unsent for {self.stall_timeout:g} s")
+            elif not self._paused and now - client.last_rx > self.client_timeout:
+                self._close(client, f"disconnecting after {self.client_timeout:g} seconds of silence")
+
+    def _close(self, client: _Client, reason: str | None, fault: bool = True) -> None:
+        if client.state == _CLOSED:
+            return
+        was_ready = client.state == _READY
+        client.state = _CLOSED
+        if reason is not None:
+            if fault:
+                log.warning("dropping client %s: %s", client.label(), reason)
+                self.dropped.append((client.label(), reason))
+            else:
+                log.info("client %s left: %s", client.label(), reason)
+        if client.events:
+            try:
+                self._selector.unregister(client.sock)  # type: ignore[union-attr]
+            except (KeyError, ValueError):
+                pass
+            client.events = 0
+        self._clients.pop(client.sock.fileno(), None)
+        try:
+            client.sock.close()
+        except OSError:
+            pass
+        self._congested.discard(client)
+        if self._paused and not self._congested:
+            self._set_paused(False)
+        if was_ready:
+            with self._lock:
+                if self._by_name.get(client.name) is client:
+                    del self._by_name[client.name]
+            self.db.disconnect(client.name)
