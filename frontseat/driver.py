@@ -99,6 +99,16 @@ class FrontSeatDriver(abc.ABC):
     def loop(self) -> None:
         """One tick of driver I/O, called by :meth:`do_work` after the state check."""
 
+    def close(self) -> None:
+        """Release the driver's I/O (sockets, threads). Idempotent; the base class holds none."""
+        return None
+
+    def __enter__(self) -> FrontSeatDriver:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
     # ----- host API ---------------------------------------------------------------------------------------
     def cfg(self) -> config_pb.Config:
         """The driver's configuration (a copy owned by the driver; treat as read-only)."""
