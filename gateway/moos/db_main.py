@@ -1,0 +1,106 @@
+"""``moos-db``: the MOOSDB role as a console script, with MOOSDB's flags.
+
+Differences from the C++ MOOSDB (see docs/moos.md): binds 127.0.0.1 unless ``--moos_address`` says otherwise;
+``--moos_port=0`` picks a free port; the chosen address is printed on stdout as
+``MOOSDB <community> listening on <host>:<port>``. Options of the C++ DB that have no meaning here
+(``-s``, ``-b``, ``--audit_port``, suicide and web-server options, ...) are accepted and ignored with a log line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import sys
+from pathlib import Path
+
+from ..logsetup import add_verbosity_argument, configure_logging
+from .errors import MissionFileError
+from .mission_file import MissionFile
+from .server import MoosDB
+
+log = logging.getLogger(__name__)
+
+_IGNORED_FLAGS = ("-s", "--single_threaded", "-b", "--moos_boost", "-d", "--dns", "--tcpnodelay",
+                  "--print_heart_beat", "--moos_suicide_disable", "--moos_suicide_print", "--moos_no_colour")
+_IGNORED_VALUES = ("--warning_latency", "--response", "--audit_port", "--event_log", "--webserver_port",
+                   "--moos_suicide_channel", "--moos_suicide_port", "--moos_suicide_phrase")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="moos-db", description="A MOOSDB-compatible MOOS v10 server.")
+    parser.add_argument("mission_file", nargs="?", help="mission file (.moos) for ServerPort, Community, "
+                        "MOOSTimeWarp and ClientTimeout (default Mission.moos if present)")
+    parser.add_argument("--moos_file", help="mission file (same as the positional argument)")
+    parser.add_argument("--moos_port", type=int, help="port to listen on (default ServerPort or 9000; 0 = any free)")
+    parser.add_argument("--moos_community", help="community name (default Community or #1)")
+    parser.add_argument("--moos_time_warp", type=float, help="time warp (default MOOSTimeWarp or 1)")
+    parser.add_argument("--moos_timeout", type=float, help="seconds of client silence before disconnect (default 5)")
+    parser.add_argument("--moos_address", default="127.0.0.1",
+                        help="address to bind (default 127.0.0.1; 0.0.0.0 for every interface like the C++ DB)")
+    parser.add_argument("--max_packet_bytes", type=int, default=64 * 1024 * 1024,
+                        help="largest packet accepted from a client before it is dropped")
+    parser.add_argument("--moos_print_version", action="store_true", help="print the version and exit")
+    for flag in _IGNORED_FLAGS:
+        parser.add_argument(flag, action="store_true", dest="ignored_" + flag.strip("-"), help=argparse.SUPPRESS)
+    for flag in _IGNORED_VALUES:
+        parser.add_argument(flag, dest="ignored_" + flag.strip("-"), help=argparse.SUPPRESS)
+    add_verbosity_argument(parser)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    configure_logging(args.verbose, "moos-db")
+    if args.moos_print_version:
+        print("moos-db (goby-moos-py) speaking MOOS v10 wire protocol \"ELKS CAN'T DANCE 2/8/10\"")
+        return 0
+    for name, value in vars(args).items():
+        if name.startswith("ignored_") and value:
+            log.info("option --%s has no effect here and is ignored", name[len("ignored_"):])
+
+    port, community, warp, timeout = 9000, "#1", 1.0, 5.0
+    path = args.moos_file or args.mission_file
+    if path is None and Path("Mission.moos").exists():
+        path = "Mission.moos"
+    if path is not None:
+        try:
+            mission = MissionFile(path)
+            port, community, warp = mission.server_port, mission.community, mission.time_warp
+            client_timeout = mission.global_value("ClientTimeout")
+            if client_timeout:
+                timeout = float(client_timeout)
+        except (MissionFileError, ValueError) as exc:
+            if args.moos_file or args.mission_file:
+                log.warning("mission file not used: %s", exc)
+    if args.moos_port is not None:
+        port = args.moos_port
+    if args.moos_community:
+        community = args.moos_community
+    if args.moos_time_warp is not None and args.moos_time_warp > 0:
+        warp = args.moos_time_warp
+    if args.moos_timeout is not None:
+        timeout = args.moos_timeout
+
+    try:
+        server = MoosDB(args.moos_address, port, community, time_warp=warp, client_timeout=timeout,
+                        max_packet_bytes=args.max_packet_bytes)
+        server.start()
+    except (OSError, ValueError) as exc:
+        log.error("cannot start the MOOSDB on %s:%d: %s", args.moos_address, port, exc)
+        return 1
+
+    def _stop(signum: int, _frame: object) -> None:
+        log.info("signal %d: stopping", signum)
+        server.stop()
+
+    signal.signal(signal.SIGINT, _stop)
+    signal.signal(signal.SIGTERM, _stop)
+    print(f"MOOSDB {community} listening on {server.host}:{server.port}", flush=True)
+    server.serve_forever()
+    server.stop()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
