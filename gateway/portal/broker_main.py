@@ -1,0 +1,76 @@
+"""``goby-broker``: run the broker for one platform (the gobyd role) until SIGINT/SIGTERM.
+
+Config: ``GobyDaemonConfig`` in protobuf text format (``app {}``, ``router_threads``, ``interprocess {}``,
+``hold { required_client: ... }``), command-line overrides such as ``--interprocess 'platform: "usv"'``, and
+``GOBY_INTERPROCESS``.  Prints one line ``goby-broker ready: {...}`` (JSON endpoints) to stdout when serving.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import signal
+import sys
+import threading
+
+from gateway.logsetup import configure_logging
+from gateway.portal.broker import Broker, BrokerError
+from gateway.portal.config import debug_text, example_config, load_config
+from gateway.portal.errors import ConfigError
+from gateway.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
+
+log = logging.getLogger(__name__)
+
+READY_PREFIX = "goby-broker ready: "
+
+
+def main(argv: list[str] | None = None) -> int:
+    try:
+        loaded = load_config(GobyDaemonConfig, argv, prog="goby-broker")
+    except ConfigError as exc:
+        print(f"goby-broker: configuration error: {exc}", file=sys.stderr)
+        return 2
+    if loaded.example_requested:
+        print(example_config(GobyDaemonConfig))
+        return 0
+    cfg = loaded.cfg
+    if loaded.debug_cfg:
+        print(debug_text(cfg), end="")
+        return 0
+    configure_logging(loaded.verbosity, cfg.app.name)
+    if not cfg.interprocess.HasField("platform"):
+        log.warning("Using default platform name of %s", cfg.interprocess.platform)
+    stop = threading.Event()
+
+    def on_signal(signum: int, _frame: object) -> None:
+        log.info("received %s; stopping", signal.Signals(signum).name)
+        stop.set()
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    broker = Broker(cfg)
+    try:
+        try:
+            broker.start()
+        except BrokerError as exc:
+            log.critical("%s", exc)
+            return 1
+        info = {"platform": cfg.interprocess.platform, **broker.endpoints(), "pid": _pid()}
+        print(READY_PREFIX + json.dumps(info), flush=True)
+        log.info("=== goby-broker is ready ===")
+        while not stop.wait(1.0):
+            pass
+        return 0
+    finally:
+        broker.stop()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _pid() -> int:
+    import os
+
+    return os.getpid()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

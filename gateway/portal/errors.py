@@ -1,0 +1,35 @@
+"""The portal's one error root and its failure kinds, so callers can catch exactly what they mean."""
+
+from __future__ import annotations
+
+
+class PortalError(Exception):
+    """Root of every error the portal raises."""
+
+
+class InvalidGroupError(PortalError, ValueError):
+    """A group that cannot be used on this layer (e.g. an empty name on interprocess)."""
+
+
+class MarshallingError(PortalError):
+    """A payload that cannot be serialized or parsed, or a scheme/type we do not know."""
+
+
+class IdentifierError(PortalError):
+    """A received frame whose wire identifier is malformed."""
+
+
+class ConfigError(PortalError):
+    """A configuration file or command-line override that does not parse."""
+
+
+class BrokerUnavailableError(PortalError):
+    """The broker's manager did not answer within ``manager_timeout_seconds``."""
+
+
+class ClosedError(PortalError):
+    """An operation on a portal, thread or broker that has already been shut down."""
+
+
+class ThreadError(PortalError):
+    """A thread launched by an application failed to start."""

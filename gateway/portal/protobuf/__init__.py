@@ -1,0 +1,1 @@
+"""Protos owned by the portal (``goby-broker``'s ``GobyDaemonConfig``)."""

@@ -1,0 +1,111 @@
+"""``run_application``: config, logging, warp, signals, the application's lifetime, and the exit code."""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable
+from typing import Any
+
+from google.protobuf import message as pb_message
+
+from gateway.logsetup import configure_logging
+from gateway.portal.config import debug_text, example_config, load_config
+from gateway.portal.context import ProcessContext, use_context
+from gateway.portal.errors import BrokerUnavailableError, ConfigError
+from gateway.portal.interface_registry import process_registry
+from gateway.portal.thread import SimpleThread, interprocess_config_of
+from gateway.portal.timeutil import SystemClock
+from gateway.portal.timeutil import clock as process_clock
+
+log = logging.getLogger(__name__)
+
+
+def apply_simulation_time(cfg: Any, clock: SystemClock = process_clock) -> None:
+    """Apply ``app.simulation.time`` (use_sim_time, warp_factor, reference_microtime) to ``clock``."""
+    descriptor = getattr(cfg, "DESCRIPTOR", None)
+    if descriptor is None or "app" not in descriptor.fields_by_name:
+        return
+    sim = cfg.app.simulation.time
+    if sim.use_sim_time:
+        reference = sim.reference_microtime if sim.HasField("reference_microtime") else None
+        clock.configure(True, sim.warp_factor, reference)
+        log.info("simulation time on: warp %d, reference %d µs", clock.warp_factor, clock.reference_micro)
+
+
+def run_application(
+    app_class: Callable[[Any], SimpleThread],
+    config_type: type[pb_message.Message],
+    argv: list[str] | None = None,
+    *,
+    prog: str | None = None,
+) -> int:
+    """Parse the configuration and run ``app_class(cfg)`` until it quits or SIGINT/SIGTERM; returns the exit code.
+
+    Exit codes: the application's ``quit(code)``; 0 for ``--example_config`` and ``debug_cfg``; 1 when the broker
+    does not answer or the application fails; 2 for a bad configuration.
+    """
+    prog = prog or os.path.basename(sys.argv[0] or "app")
+    try:
+        loaded = load_config(config_type, argv, prog)
+    except ConfigError as exc:
+        print(f"{prog}: configuration error: {exc}", file=sys.stderr)
+        return 2
+    if loaded.example_requested:
+        print(example_config(config_type))
+        return 0
+    cfg = loaded.cfg
+    if loaded.debug_cfg:
+        print(debug_text(cfg), end="")
+        return 0
+    app_name = cfg.app.name if "app" in cfg.DESCRIPTOR.fields_by_name else prog
+    configure_logging(loaded.verbosity, app_name)
+    apply_simulation_time(cfg)
+    context = ProcessContext(interprocess_config_of(cfg), application=app_name)
+    app: SimpleThread | None = None
+    restore = _install_signal_handlers(lambda: app.quit() if app is not None else None)
+    try:
+        with use_context(context):
+            try:
+                app = app_class(cfg)
+            except BrokerUnavailableError as exc:
+                log.critical("%s", exc)
+                return 1
+            except Exception:
+                log.exception("%s failed to start", app_name)
+                return 1
+            try:
+                app.run()
+            except Exception:
+                log.exception("%s failed", app_name)
+                return 1
+            return int(getattr(app, "return_code", 0))
+    finally:
+        if app is not None:
+            app.close()
+        context.close()
+        restore()
+        process_registry.write_if_requested()
+
+
+def _install_signal_handlers(on_signal: Callable[[], None]) -> Callable[[], None]:
+    """SIGINT/SIGTERM -> ``on_signal`` (clean shutdown); returns a function restoring the previous handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+    previous = {}
+
+    def handler(signum: int, _frame: object) -> None:
+        log.info("received %s; shutting down", signal.Signals(signum).name)
+        on_signal()
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        previous[sig] = signal.signal(sig, handler)
+
+    def restore() -> None:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+    return restore

@@ -1,0 +1,243 @@
+"""Helpers for tests in every area: a broker subprocess on a private IPC path, the config apps need to join it,
+and a small portal client driven from the test's own thread.
+
+    with broker_process(tmp_path, platform="t1") as broker:
+        env = {**os.environ, "GOBY_INTERPROCESS": broker.interprocess_text()}
+        with PortalClient(broker.interprocess_config()) as client:
+            got = client.collect("nav", NodeStatus)
+            client.wait_subscribed()
+            ...
+            client.poll_until(lambda: len(got) == 3)
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import selectors
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import uuid
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+from google.protobuf import text_format
+
+from gateway.portal.broker_main import READY_PREFIX
+from gateway.portal.context import ProcessContext
+from gateway.portal.errors import PortalError
+from gateway.portal.group import GroupLike
+from gateway.portal.interprocess import InterProcessPortal
+from gateway.portal.transports import ThreadTransports
+from gateway.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+
+#: Unix socket paths are limited to 107 bytes; longer temp dirs fall back to a short one under /tmp.
+_MAX_IPC_BASE = 90
+
+
+class BrokerProcess:
+    """A ``goby-broker`` subprocess; ``start``/``stop``/``kill``/``restart`` may be called repeatedly."""
+
+    def __init__(self, directory: Path, platform: str = "test", tcp: bool = False, extra_args: list[str] | None = None,
+                 startup_timeout: float = 30.0) -> None:
+        self.platform = platform
+        self.tcp = tcp
+        self._own_dir: str | None = None
+        base = Path(directory) / f"goby_{platform}"
+        if len(str(base)) > _MAX_IPC_BASE:
+            self._own_dir = tempfile.mkdtemp(prefix="gb", dir="/tmp")
+            base = Path(self._own_dir) / f"goby_{platform}"
+        self.socket_base = str(base)
+        self.extra_args = list(extra_args or [])
+        self.startup_timeout = startup_timeout
+        self.process: subprocess.Popen[str] | None = None
+        self.endpoints: dict[str, Any] = {}
+        self.manager_port = 0
+
+    def _config(self) -> InterProcessPortalConfig:
+        cfg = InterProcessPortalConfig(platform=self.platform)
+        if self.tcp:
+            cfg.transport = InterProcessPortalConfig.TCP
+            cfg.tcp_port = self.manager_port
+        else:
+            cfg.socket_name = self.socket_base
+        return cfg
+
+    def interprocess_config(self) -> InterProcessPortalConfig:
+        """The ``interprocess`` block an app needs to join this broker."""
+        return self._config()
+
+    def interprocess_text(self) -> str:
+        """The same block in one-line text format: the value for ``GOBY_INTERPROCESS`` or ``--interprocess``."""
+        return text_format.MessageToString(self._config(), as_one_line=True)
+
+    def env(self, base: dict[str, str] | None = None) -> dict[str, str]:
+        """An environment for app subprocesses with ``GOBY_INTERPROCESS`` pointing here."""
+        env = dict(os.environ if base is None else base)
+        env["GOBY_INTERPROCESS"] = self.interprocess_text()
+        return env
+
+    def start(self) -> BrokerProcess:
+        """Start the broker and wait for its ready line; raises ``PortalError`` if it does not come up."""
+        if self.process is not None and self.process.poll() is None:
+            return self
+        cfg = self._config()
+        if self.tcp and not self.manager_port:
+            cfg.tcp_port = 0
+        args = [sys.executable, "-m", "gateway.portal.broker_main",
+                "--interprocess", text_format.MessageToString(cfg, as_one_line=True), *self.extra_args]
+        self.process = subprocess.Popen(args, stdout=subprocess.PIPE, text=True)
+        line = self._read_ready_line()
+        self.endpoints = json.loads(line[len(READY_PREFIX):])
+        if self.tcp and not self.manager_port:
+            self.manager_port = int(self.endpoints["manager"].rsplit(":", 1)[1])
+        return self
+
+    def _read_ready_line(self) -> str:
+        assert self.process is not None and self.process.stdout is not None
+        deadline = time.monotonic() + self.startup_timeout
+        with selectors.DefaultSelector() as sel:
+            sel.register(self.process.stdout, selectors.EVENT_READ)
+            while time.monotonic() < deadline:
+                if sel.select(timeout=0.2):
+                    line = self.process.stdout.readline()
+                    if line.startswith(READY_PREFIX):
+                        return line.strip()
+                    if not line and self.process.poll() is not None:
+                        break
+                elif self.process.poll() is not None:
+                    break
+        code = self.process.poll()
+        self.stop()
+        raise PortalError(f"goby-broker for platform {self.platform!r} did not become ready (exit code {code})")
+
+    def stop(self, timeout: float = 10.0) -> int | None:
+        """SIGTERM, wait, SIGKILL if needed; returns the exit code (idempotent)."""
+        proc, self.process = self.process, None
+        if proc is None:
+            return None
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGTERM)
+            try:
+                proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+        if proc.stdout is not None:
+            proc.stdout.close()
+        return proc.returncode
+
+    def kill(self) -> None:
+        """SIGKILL (a crash); the IPC files stay behind, as after a real crash."""
+        proc, self.process = self.process, None
+        if proc is not None:
+            proc.kill()
+            proc.wait()
+            if proc.stdout is not None:
+                proc.stdout.close()
+
+    def restart(self) -> BrokerProcess:
+        self.stop()
+        return self.start()
+
+    def close(self) -> None:
+        self.stop()
+        if self._own_dir is not None:
+            shutil.rmtree(self._own_dir, ignore_errors=True)
+            self._own_dir = None
+
+    def __enter__(self) -> BrokerProcess:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+@contextmanager
+def broker_process(tmp_path: Path, platform: str = "test", tcp: bool = False,
+                   extra_args: list[str] | None = None) -> Iterator[BrokerProcess]:
+    """Start ``goby-broker`` on an IPC path in ``tmp_path`` (or TCP on 127.0.0.1), yield it, stop it."""
+    broker = BrokerProcess(tmp_path, platform, tcp, extra_args)
+    with broker:
+        yield broker
+
+
+class PortalClient:
+    """A portal driven by the test's own thread: publish, subscribe, and ``poll`` to run callbacks.
+
+    Use it from one thread only.  The hold settles after ``hold_settle_s`` (default 0.2 s, Goby uses 1 s).
+    """
+
+    def __init__(self, interprocess: InterProcessPortalConfig, name: str = "test_client",
+                 hold_settle_s: float = 0.2) -> None:
+        self.context = ProcessContext(interprocess, client_name=name, application=name, hold_settle_s=hold_settle_s)
+        self._transports = ThreadTransports(self.context, name)
+        try:
+            self.portal: InterProcessPortal = self._transports.interprocess()
+        except BaseException:
+            self._transports.close()
+            self.context.close()
+            raise
+        self.portal.ready()
+
+    def publish(self, group: GroupLike, msg: Any, **kwargs: Any) -> None:
+        self.portal.publish(group, msg, **kwargs)
+
+    def subscribe(self, group: GroupLike, msg_type: type, callback: Callable[[Any], None], **kwargs: Any) -> None:
+        """``callback`` runs on the test's thread inside :meth:`poll`."""
+        self.portal.subscribe(group, msg_type, callback, **kwargs)
+
+    def collect(self, group: GroupLike, msg_type: type, **kwargs: Any) -> list[Any]:
+        """Subscribe and return the list the received messages are appended to."""
+        received: list[Any] = []
+        self.portal.subscribe(group, msg_type, received.append, **kwargs)
+        return received
+
+    def poll(self, timeout_s: float = 0.0) -> int:
+        return self._transports.poll(timeout_s)
+
+    def poll_until(self, predicate: Callable[[], bool], timeout_s: float = 20.0) -> bool:
+        """Poll until ``predicate()`` is true; returns False on timeout."""
+        deadline = time.monotonic() + timeout_s
+        while not predicate():
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                return False
+            self.poll(min(0.05, remaining))
+        return True
+
+    def wait_ready(self, timeout_s: float = 20.0) -> bool:
+        """Poll until the manager has released the hold (publications flow)."""
+        return self.poll_until(lambda: not self.portal.hold_state(), timeout_s)
+
+    def wait_subscribed(self, timeout_s: float = 20.0) -> bool:
+        """Return once this client's subscriptions have reached the broker (a probe round trip), hold released."""
+        if not self.wait_ready(timeout_s):
+            return False
+        probe_group = f"_portal_client_probe_{uuid.uuid4().hex}"
+        seen: list[str] = []
+        self.portal.subscribe(probe_group, str, seen.append)
+        deadline = time.monotonic() + timeout_s
+        try:
+            while not seen and time.monotonic() < deadline:
+                self.portal.publish(probe_group, "probe")
+                self.poll_until(lambda: bool(seen), 0.1)
+        finally:
+            self.portal.unsubscribe(probe_group, str)
+        return bool(seen)
+
+    def close(self) -> None:
+        self._transports.close()
+        self.context.close()
+
+    def __enter__(self) -> PortalClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
