@@ -106,6 +106,7 @@ class comms:  # noqa: N801 - pymoos's class name
         self._bytes_sent_total = 0
         self._bytes_read_total = 0
         self._fatal: MoosError | None = None
+        self.welcome: Welcome | None = None  # the DB's last WELCOME (community, skew, DB time, hostname)
 
     # ---- lifecycle ---------------------------------------------------------------------------------
     def run(self, server: str, port: int, name: str, comms_tick: float = 5) -> bool:
@@ -537,6 +538,7 @@ class comms:  # noqa: N801 - pymoos's class name
 
     def _serve(self, conn: PacketSocket, welcome: Welcome) -> None:
         """One connection's life: apply the WELCOME, re-register, call on-connect, then read until it ends."""
+        self.welcome = welcome
         self._community = welcome.community
         self._db_hostname = welcome.db_hostname
         same_host = welcome.db_hostname == socket.gethostname()

@@ -1,0 +1,123 @@
+"""``moos-scope``: a live table of MOOS variables, in the spirit of uXMS.
+
+``moos-scope [mission.moos] VAR ... [--all] [--once | --duration S]``: shows each variable's value, source,
+time and community. ``--once`` prints one table as soon as every variable has been seen (or after
+``--timeout``); ``--duration`` refreshes the table for that many seconds; with neither it runs until Ctrl-C.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import sys
+import threading
+import time
+
+from ..logsetup import add_verbosity_argument, configure_logging
+from .client import comms
+from .clock import MoosClock
+from .message import MoosMessage
+from .tool_args import add_server_arguments, resolve_server, split_mission_file
+
+log = logging.getLogger(__name__)
+
+
+def format_value(msg: MoosMessage | None, width: int = 40) -> str:
+    if msg is None:
+        return "n/a"
+    if msg.is_binary():
+        return f"*binary* {msg.binary_data_size()} B"
+    if msg.is_double():
+        return f"{msg.double():g}"
+    text = msg.string().replace("\n", "\\n")
+    return f'"{text}"' if len(text) <= width else f'"{text[: width - 3]}..."'
+
+
+def render_table(names: list[str], latest: dict[str, MoosMessage], start_time: float) -> str:
+    """The table uXMS prints: name, source, time (since scope start), community, value."""
+    rows = [f"  {'VarName':<24} {'(S)ource':<16} {'(T)ime':>10}  {'(C)ommunity':<12} VarValue",
+            f"  {'-' * 24} {'-' * 16} {'-' * 10}  {'-' * 12} {'-' * 20}"]
+    for name in names:
+        msg = latest.get(name)
+        if msg is None:
+            rows.append(f"  {name:<24} {'n/a':<16} {'n/a':>10}  {'n/a':<12} n/a")
+            continue
+        rows.append(f"  {name:<24} {msg.source():<16} {msg.time() - start_time:>10.2f}  "
+                    f"{msg.community():<12} {format_value(msg)}")
+    return "\n".join(rows)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="moos-scope", description="Watch MOOS variables (like uXMS).")
+    parser.add_argument("items", nargs="*", help="[mission.moos] VAR ...")
+    parser.add_argument("--all", action="store_true", help="show every variable (wildcard registration)")
+    parser.add_argument("--name", default="uXMS", help="client name (default uXMS)")
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument("--once", action="store_true", help="print one table and exit")
+    mode.add_argument("--duration", type=float, help="refresh for this many seconds, then exit")
+    parser.add_argument("--timeout", type=float, default=5.0, help="--once: longest wait for the variables")
+    parser.add_argument("--refresh", type=float, default=1.0, help="seconds between live refreshes")
+    add_server_arguments(parser)
+    add_verbosity_argument(parser)
+    args = parser.parse_args(argv)
+    configure_logging(args.verbose, "moos-scope")
+    mission, names = split_mission_file(args.items)
+    if not names and not args.all:
+        parser.error("give variable names, or --all")
+    host, port, warp = resolve_server(args, mission)
+
+    clock = MoosClock(warp or 1.0)
+    client = comms(clock=clock)
+    latest: dict[str, MoosMessage] = {}
+    watched = list(names)
+    stop = threading.Event()
+
+    def on_connect() -> bool:
+        for name in names:
+            client.register(name, 0)
+        if args.all:
+            client.register("*", "*", 0)
+        return True
+
+    client.set_on_connect_callback(on_connect)
+    client.run(host, port, args.name)
+    if not (args.once or args.duration):
+        signal.signal(signal.SIGINT, lambda *_: stop.set())
+    try:
+        if not client.wait_until_connected(args.connect_timeout * 1000):
+            reason = client.get_fatal_error() or f"no DB at {host}:{port} within {args.connect_timeout:g} s"
+            print(f"moos-scope: cannot connect: {reason}", file=sys.stderr)
+            return 1
+        start = clock.time()
+        if args.once:
+            deadline = time.monotonic() + args.timeout
+        elif args.duration is not None:
+            deadline = time.monotonic() + args.duration
+        else:
+            deadline = float("inf")
+        next_draw = time.monotonic()
+        while not stop.is_set():
+            for msg in client.fetch():
+                latest[msg.key()] = msg
+                if args.all and msg.key() not in watched:
+                    watched.append(msg.key())
+            now = time.monotonic()
+            if args.once:
+                if (names and all(n in latest for n in names)) or now >= deadline:
+                    print(render_table(watched, latest, start), flush=True)
+                    return 0 if all(n in latest for n in names) else 2
+            elif now >= next_draw:
+                clear = "\x1b[2J\x1b[H" if sys.stdout.isatty() else ""
+                print(clear + render_table(sorted(watched) if args.all else watched, latest, start), flush=True)
+                next_draw = now + args.refresh
+            if now >= deadline:
+                return 0
+            stop.wait(0.02)
+        return 0
+    finally:
+        client.close(True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
