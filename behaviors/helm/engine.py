@@ -1,0 +1,143 @@
+"""The behaviour set's iteration (BehaviorSet::produceOF + HelmEngine): states, flags, updates, decision.
+
+One call to :meth:`HelmEngine.iterate` is one decision iteration. Behaviour postings are written into
+the info buffer only after every behaviour has run, so a flag raised this iteration is seen by other
+behaviours' conditions on the next one, as in pHelmIvP.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+from .behavior import Behavior, Posting
+from .geometry import fmt_num
+from .info_buffer import InfoBuffer, Value
+from .ivp import IvPDomain, ObjectiveFunction, solve
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class EngineResult:
+    """What one iteration decided and wants posted (postings already passed the duplicate filter)."""
+
+    decisions: dict[str, float]
+    function_count: int
+    postings: list[Posting]
+    states: dict[str, str] = field(default_factory=dict)
+    removed: list[str] = field(default_factory=list)
+
+
+class HelmEngine:
+    """Runs the behaviours in declaration order and solves the weighted sum of their functions."""
+
+    def __init__(self, domain: IvPDomain, behaviors: list[Behavior], info: InfoBuffer) -> None:
+        self.domain, self.behaviors, self.info = domain, list(behaviors), info
+        self.iteration = 0
+        self._last_posted: dict[str, Value] = {}
+        self._configured: set[str] = set()
+
+    def clear_post_filter(self) -> None:
+        """HELM_MAP_CLEAR: forget what was posted so everything is posted again."""
+        self._last_posted.clear()
+
+    def iterate(self, now: float) -> EngineResult:
+        self.iteration += 1
+        functions: list[ObjectiveFunction] = []
+        extra: list[Posting] = []
+        states: dict[str, str] = {}
+        for bhv in self.behaviors:
+            bhv.now = now
+            extra.extend(self._apply_updates(bhv, now))
+            fn = self._step(bhv, now)
+            states[bhv.name] = bhv.state
+            if fn is not None and bhv.pwt > 0:
+                functions.append(fn)
+        decisions = solve(self.domain, functions)
+        self.info.clear_deltas()
+        postings = extra
+        removed: list[str] = []
+        for bhv in self.behaviors:
+            postings.extend(self._filter(bhv, bhv.outbox, now))
+            bhv.outbox = []
+            if bhv.completed and not bhv.perpetual:
+                removed.append(bhv.name)
+                postings.append(Posting("IVPHELM_LIFE_EVENT",
+                                        f"iter={self.iteration},time={fmt_num(now, 2)},bname={bhv.name},"
+                                        f"btype={bhv.TYPE},event=death", repeatable=True))
+        self.behaviors = [b for b in self.behaviors if b.name not in removed]
+        return EngineResult(decisions, len(functions), postings, states, removed)
+
+    def _apply_updates(self, bhv: Behavior, now: float) -> list[Posting]:
+        results: list[Posting] = []
+        if not bhv.updates_var:
+            return results
+        for value in self.info.deltas(bhv.updates_var):
+            if not isinstance(value, str):
+                continue
+            result = bhv.apply_update(value)
+            if result == "empty":
+                continue
+            results.append(Posting("IVPHELM_UPDATE_RESULT", f"bhv={bhv.name},var={bhv.updates_var},"
+                                   f"time={fmt_num(now, 2)},result={result},val={value}", repeatable=True))
+            if result == "success":
+                bhv.post_flags("configflag", repeatable=False)
+        return results
+
+    def _step(self, bhv: Behavior, now: float) -> ObjectiveFunction | None:
+        """One behaviour through idle / running / active / completed, posting its flags on transitions."""
+        previous = bhv.state
+        if bhv.name not in self._configured:
+            self._configured.add(bhv.name)
+            bhv.post_flags("configflag", repeatable=False)
+        if bhv.completed:
+            bhv.state = "completed"
+            bhv.on_complete_state()
+            return None
+        failed = bhv.conditions_hold()
+        bhv.tick_clock(now, failed is None)
+        if bhv.completed:
+            bhv.state = "completed"
+            bhv.on_complete_state()
+            return None
+        fn: ObjectiveFunction | None = None
+        if failed is not None:
+            bhv.state = "idle"
+            if previous != "idle":
+                bhv.post_flags("idleflag")
+                bhv.post_flags("inactiveflag")
+            if previous in ("running", "active"):
+                bhv.on_run_to_idle_state()
+            bhv.on_idle_state()
+        else:
+            if previous == "idle":
+                bhv.on_idle_to_run_state()
+            fn = bhv.on_run_state()
+            if previous in ("idle", ""):
+                bhv.post_flags("runflag")
+            bhv.post_flags("runxflag")
+            if fn is not None and bhv.pwt > 0:
+                bhv.state = "active"
+                if previous != "active":
+                    bhv.post_flags("activeflag")
+            else:
+                bhv.state = "running"
+                if previous == "active":
+                    bhv.post_flags("inactiveflag")
+                bhv.on_inactive_state()
+        if bhv.completed:
+            bhv.state = "completed"
+            return None
+        return fn
+
+    def _filter(self, bhv: Behavior, outbox: list[Posting], now: float) -> list[Posting]:
+        """Write every posting into the info buffer; pass repeatable ones and changed values on."""
+        passed = []
+        for posting in outbox:
+            self.info.set(posting.var, posting.value, now)
+            key = f"{bhv.name}|{posting.var}|{posting.key}"
+            if posting.repeatable or self._last_posted.get(key) != posting.value:
+                self._last_posted[key] = posting.value
+                passed.append(posting)
+        return passed

@@ -1,0 +1,157 @@
+"""The IvP domain, ZAIC_PEAK objective functions, and the per-variable grid solver (spec §6).
+
+Every behaviour here builds a separable function (a sum of one-variable pieces), so the weighted sum
+over behaviours is maximised one decision variable at a time over that variable's grid.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .errors import ParamError
+from .logic import is_number
+
+
+@dataclass(frozen=True)
+class DomainVar:
+    name: str
+    low: float
+    high: float
+    points: int
+    optional: bool = False
+
+    @property
+    def delta(self) -> float:
+        return 0.0 if self.points <= 1 else (self.high - self.low) / (self.points - 1)
+
+    def grid(self) -> list[float]:
+        return [self.low + j * self.delta for j in range(self.points)]
+
+    def snap(self, value: float, wrap: bool = False) -> float:
+        """The grid value nearest ``value`` (circular for a wrapping variable such as course)."""
+        values = self.grid()
+        if wrap:
+            period = self.high - self.low + self.delta
+            return min(values, key=lambda g: abs((value - g + period / 2) % period - period / 2))
+        return min(values, key=lambda g: abs(value - g))
+
+
+class IvPDomain:
+    """Decision variables in declaration order (``domain = course:0:359:360`` lines)."""
+
+    def __init__(self) -> None:
+        self.vars: dict[str, DomainVar] = {}
+
+    def add(self, spec: str) -> DomainVar:
+        """Parse ``name:low:high:npts[:optional]`` or ``name:low:high:delta=D`` (commas allowed too)."""
+        fields = [f.strip() for f in spec.replace(",", ":").split(":")]
+        if len(fields) < 4:
+            raise ParamError(f"domain '{spec}': expected name:low:high:npts")
+        name, low_s, high_s, pts_s = fields[:4]
+        extra = [f.lower() for f in fields[4:]]
+        if not name or not is_number(low_s) or not is_number(high_s):
+            raise ParamError(f"domain '{spec}': low and high must be numbers")
+        low, high = float(low_s), float(high_s)
+        if pts_s.lower().startswith("delta="):
+            step = pts_s.split("=", 1)[1]
+            if not is_number(step) or float(step) <= 0:
+                raise ParamError(f"domain '{spec}': bad delta")
+            points = int((high - low) / float(step) + 1)
+        elif is_number(pts_s) and float(pts_s) == int(float(pts_s)):
+            points = int(float(pts_s))
+        else:
+            raise ParamError(f"domain '{spec}': npts must be a whole number")
+        if high < low or points < 1 or (high == low) != (points == 1):
+            raise ParamError(f"domain '{spec}': need high >= low, and npts == 1 exactly when high == low")
+        if extra and extra != ["optional"]:
+            raise ParamError(f"domain '{spec}': unknown option '{':'.join(fields[4:])}'")
+        if name in self.vars:
+            raise ParamError(f"domain '{spec}': {name} declared twice")
+        var = DomainVar(name, low, high, points, bool(extra))
+        self.vars[name] = var
+        return var
+
+    def has(self, name: str) -> bool:
+        return name in self.vars
+
+    def summary(self) -> str:
+        """IVPHELM_DOMAIN: ``course,0,359,360:speed,0,4,41``."""
+        return ":".join(f"{v.name},{_g(v.low)},{_g(v.high)},{v.points}" for v in self.vars.values())
+
+
+def _g(value: float) -> str:
+    return str(int(value)) if value == int(value) else repr(value)
+
+
+def zaic_peak(var: DomainVar, summit: float, peakwidth: float, basewidth: float, summitdelta: float,
+              minutil: float = 0.0, maxutil: float = 100.0, wrap: bool = False) -> list[float]:
+    """ZAIC_PEAK utilities over ``var``'s grid (spec §6), circular distance when ``wrap``."""
+    grid = var.grid()
+    period = var.high - var.low + var.delta
+    sd = summitdelta if peakwidth > 0 else 0.0
+    out = []
+    for x in grid:
+        d = abs(x - summit)
+        if wrap:
+            d = d % period
+            d = min(d, period - d)
+        if d <= peakwidth:
+            u = maxutil - (sd / peakwidth) * d if peakwidth > 0 else maxutil
+        elif d <= peakwidth + basewidth:
+            u = (maxutil - sd) - ((maxutil - sd - minutil) / basewidth) * (d - peakwidth)
+        else:
+            u = minutil
+        out.append(u)
+    if all(u == minutil for u in out):
+        nearest = min(range(len(grid)), key=lambda j: abs(grid[j] - summit))
+        out[nearest] = maxutil
+    return out
+
+
+def normalise(values: list[float], top: float) -> list[float]:
+    """Affinely map ``values`` onto [0, top] (OF_Coupler's per-piece normalisation)."""
+    lo, hi = min(values), max(values)
+    if hi == lo:
+        return [0.0] * len(values)
+    return [top * (v - lo) / (hi - lo) for v in values]
+
+
+@dataclass
+class ObjectiveFunction:
+    """A separable IvP function: per variable, utilities on the grid (already weighted); times ``pwt``."""
+
+    pwt: float
+    pieces: dict[str, list[float]] = field(default_factory=dict)
+
+    @classmethod
+    def single(cls, pwt: float, var: str, utilities: list[float]) -> ObjectiveFunction:
+        """A one-variable ZAIC; its 0..100 range is kept (the helm rescales only ranges above 100)."""
+        if max(utilities) - min(utilities) > 100:
+            utilities = normalise(utilities, 100.0)
+        return cls(pwt, {var: utilities})
+
+    @classmethod
+    def coupled(cls, pwt: float, var1: str, u1: list[float], w1: float,
+                var2: str, u2: list[float], w2: float) -> ObjectiveFunction:
+        """OF_Coupler: each piece normalised to [0, w]; the weights add to 100."""
+        total = w1 + w2
+        return cls(pwt, {var1: normalise(u1, 100.0 * w1 / total), var2: normalise(u2, 100.0 * w2 / total)})
+
+
+def solve(domain: IvPDomain, functions: list[ObjectiveFunction]) -> dict[str, float]:
+    """Per decision variable, the grid value maximising Σ pwt·utility; ties go to the lowest grid index."""
+    decisions: dict[str, float] = {}
+    for name, var in domain.vars.items():
+        scores: list[float] | None = None
+        for fn in functions:
+            piece = fn.pieces.get(name)
+            if piece is None or fn.pwt <= 0:
+                continue
+            if scores is None:
+                scores = [0.0] * var.points
+            for j, u in enumerate(piece):
+                scores[j] += fn.pwt * u
+        if scores is not None:
+            best = max(range(var.points), key=lambda j: (scores[j], -j))
+            decisions[name] = var.low + best * var.delta
+    return decisions
