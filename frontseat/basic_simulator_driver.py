@@ -23,7 +23,7 @@ from frontseat.simulator import protocol
 
 log = logging.getLogger(__name__)
 
-EXTENSION = sim_pb.basic_simulator_config
+CONFIG_EXTENSION = sim_pb.basic_simulator_config
 EXTENSION_NAME = "goby.middleware.frontseat.protobuf.basic_simulator_config"
 
 _CTRL_STATES = {"PAYLOAD": fs_pb.FRONTSEAT_ACCEPTING_COMMANDS, "AUV": fs_pb.FRONTSEAT_IN_CONTROL}
@@ -39,10 +39,10 @@ class BasicSimulatorDriver(FrontSeatDriver):
 
     def __init__(self, cfg: config_pb.Config, *, clock: Clock | None = None) -> None:
         super().__init__(cfg, clock=clock)
-        if not cfg.HasExtension(EXTENSION):
+        if not cfg.HasExtension(CONFIG_EXTENSION):
             raise ConfigError(f"frontseat_cfg has no [{EXTENSION_NAME}] block; the basic simulator driver needs one")
         self.sim_cfg = sim_pb.BasicSimulatorFrontSeatConfig()
-        self.sim_cfg.CopyFrom(cfg.Extensions[EXTENSION])
+        self.sim_cfg.CopyFrom(cfg.Extensions[CONFIG_EXTENSION])
         missing = self.sim_cfg.FindInitializationErrors()
         if missing:
             raise ConfigError(f"[{EXTENSION_NAME}] is missing required field(s): {', '.join(missing)}")

@@ -1,0 +1,237 @@
+"""``frontseat-interface``: the goby_frontseat_interface process.
+
+It loads one driver (``FRONTSEAT_DRIVER_LIBRARY``), ticks it at 10 Hz times warp on the main thread, and
+bridges it to the interprocess portal with Goby's groups and state gating: commands reach the frontseat
+only in COMMAND, data and raw in LISTEN or COMMAND. Status goes out every ``status_period`` (simulated)
+seconds. With a ``[goby.moos.protobuf.moos_helm]`` block it also runs the FrontSeatTranslation thread,
+which connects pHelmIvP (or any MOOS helm) through a MOOSDB.
+
+Threading: every subscription callback, the driver's signals and the driver itself run on the main thread.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+from functools import partial
+
+from frontseat import groups
+from frontseat.driver import FrontSeatDriver
+from frontseat.errors import DriverLoadError, FrontSeatException
+from frontseat.loading import ENV_VAR, DriverFactory, driver_factory, load_driver_library
+from frontseat.protobuf import frontseat_config_pb2 as config_pb
+from frontseat.protobuf import frontseat_data_pb2 as data_pb
+from frontseat.protobuf import frontseat_interface_config_pb2 as app_pb
+from frontseat.protobuf import frontseat_pb2 as fs_pb
+from frontseat.protobuf import moos_helm_frontseat_interface_config_pb2 as helm_pb
+from frontseat.protobuf import navigation_pb2 as nav_pb
+from gateway.portal import MultiThreadApplication, run_application
+from gateway.protobuf import moos_gateway_config_pb2 as gateway_pb
+
+log = logging.getLogger(__name__)
+
+LOOP_FREQUENCY_HZ = 10.0
+_ERROR_STATES = (fs_pb.INTERFACE_HELM_ERROR, fs_pb.INTERFACE_FS_ERROR)
+
+
+def driver_config(cfg: app_pb.FrontSeatInterfaceConfig) -> config_pb.Config:
+    """``frontseat_cfg`` completed as Goby does: name = platform, origin = app.geodesy, warp from sim time."""
+    out = config_pb.Config()
+    out.CopyFrom(cfg.frontseat_cfg)
+    out.name = cfg.interprocess.platform
+    out.origin.lat = cfg.app.geodesy.lat_origin  # an absent geodesy block reads as (0, 0), as in Goby
+    out.origin.lon = cfg.app.geodesy.lon_origin
+    if cfg.app.simulation.time.use_sim_time:
+        out.sim_warp_factor = cfg.app.simulation.time.warp_factor
+    return out
+
+
+def helm_gateway_config(cfg: app_pb.FrontSeatInterfaceConfig) -> gateway_pb.GobyMOOSGatewayConfig | None:
+    """The FrontSeatTranslation thread's config {app, interprocess, moos = moos_helm}, or None without moos_helm."""
+    if not cfg.HasExtension(helm_pb.moos_helm):
+        return None
+    gateway_cfg = gateway_pb.GobyMOOSGatewayConfig()
+    gateway_cfg.app.CopyFrom(cfg.app)
+    gateway_cfg.interprocess.CopyFrom(cfg.interprocess)
+    gateway_cfg.moos.CopyFrom(cfg.Extensions[helm_pb.moos_helm])
+    return gateway_cfg
+
+
+class FrontSeatInterface(MultiThreadApplication):
+    """The interface application: one driver, the portal, and optionally the MOOS helm thread."""
+
+    def __init__(self, cfg: app_pb.FrontSeatInterfaceConfig, driver_factory: DriverFactory) -> None:
+        super().__init__(cfg, LOOP_FREQUENCY_HZ)
+        self._driver: FrontSeatDriver = driver_factory(driver_config(cfg))
+        try:
+            self._connect_driver()
+            self._subscribe()
+            self._launch_helm_interface()
+        except BaseException:
+            self._driver.close()
+            raise
+        self._next_status: float | None = None
+        self._last_failure = ""
+
+    @property
+    def driver(self) -> FrontSeatDriver:
+        return self._driver
+
+    # ----- wiring -----------------------------------------------------------------------------------------
+    def _connect_driver(self) -> None:
+        portal = self.interprocess()
+        self._driver.signal_command_response.connect(lambda r: portal.publish(groups.command_response, r))
+        self._driver.signal_data_from_frontseat.connect(self._on_data_from_frontseat)
+        self._driver.signal_raw_from_frontseat.connect(lambda raw: portal.publish(groups.raw_in, raw))
+        self._driver.signal_raw_to_frontseat.connect(lambda raw: portal.publish(groups.raw_out, raw))
+
+    def _on_data_from_frontseat(self, data: fs_pb.InterfaceData) -> None:
+        self.interprocess().publish(groups.data_from_frontseat, data)
+        if data.HasField("node_status"):
+            self.interprocess().publish(groups.node_status, data.node_status)
+
+    def _subscribe(self) -> None:
+        portal = self.interprocess()
+        portal.subscribe(groups.helm_state, fs_pb.HelmStateReport, self._on_helm_state)
+        portal.subscribe(groups.command_request, fs_pb.CommandRequest, self._on_command_request)
+        portal.subscribe(groups.desired_course, data_pb.DesiredCourse, self._on_desired_course)
+        portal.subscribe(groups.data_to_frontseat, fs_pb.InterfaceData, self._on_data_to_frontseat)
+        portal.subscribe(groups.raw_send_request, fs_pb.Raw, self._on_raw_send_request)
+        portal.subscribe(groups.datum_update, nav_pb.DatumUpdate, self._on_datum_update)
+
+    def _launch_helm_interface(self) -> None:
+        gateway_cfg = helm_gateway_config(self.cfg())
+        if gateway_cfg is None:
+            return
+        log.info("launching the MOOS helm interface thread (MOOSDB %s:%d)", gateway_cfg.moos.server,
+                 gateway_cfg.moos.port)
+        try:
+            from translators.frontseat_translation import FrontSeatTranslation
+        except ImportError as exc:
+            raise FrontSeatException(
+                f"the config has a [goby.moos.protobuf.moos_helm] block but the MOOS helm interface "
+                f"(translators.frontseat_translation.FrontSeatTranslation) cannot be imported: {exc}"
+            ) from exc
+        self.launch_thread(FrontSeatTranslation, gateway_cfg)
+
+    # ----- subscriptions (main thread) -------------------------------------------------------------------
+    def _on_helm_state(self, report: fs_pb.HelmStateReport) -> None:
+        self._driver.set_helm_state(report.state)
+
+    def _on_command_request(self, command: fs_pb.CommandRequest) -> None:
+        if self._driver.state() != fs_pb.INTERFACE_COMMAND:
+            log.debug("not sending command because the interface is not in the command state")
+            return
+        self._driver.send_command_to_frontseat(command)
+
+    def _on_desired_course(self, course: data_pb.DesiredCourse) -> None:
+        if self._driver.state() != fs_pb.INTERFACE_COMMAND:
+            log.debug("not sending desired course because the interface is not in the command state")
+            return
+        command = fs_pb.CommandRequest()
+        command.desired_course.CopyFrom(course)
+        self._driver.send_command_to_frontseat(command)
+
+    def _on_data_to_frontseat(self, data: fs_pb.InterfaceData) -> None:
+        if self._driver.state() not in (fs_pb.INTERFACE_COMMAND, fs_pb.INTERFACE_LISTEN):
+            log.debug("not sending data because the interface is not in the command or listen state")
+            return
+        self._driver.send_data_to_frontseat(data)
+
+    def _on_raw_send_request(self, raw: fs_pb.Raw) -> None:
+        if self._driver.state() not in (fs_pb.INTERFACE_COMMAND, fs_pb.INTERFACE_LISTEN):
+            log.debug("not sending raw because the interface is not in the command or listen state")
+            return
+        self._driver.send_raw_to_frontseat(raw)
+
+    def _on_datum_update(self, update: nav_pb.DatumUpdate) -> None:
+        try:
+            self._driver.update_utm_datum(update.datum)
+            log.info("UTM datum moved to (%f, %f)", update.datum.lat, update.datum.lon)
+        except FrontSeatException as exc:
+            log.error("ignoring datum update: %s", exc)
+
+    # ----- the tick ---------------------------------------------------------------------------------------
+    def loop(self) -> None:
+        try:
+            self._driver.do_work()
+        except Exception as exc:
+            # A driver bug, not a frontseat condition: report it (once per distinct failure) and keep serving.
+            text = f"{type(exc).__name__}: {exc}"
+            if text != self._last_failure:
+                log.exception("the frontseat driver failed in do_work(); continuing")
+            self._last_failure = text
+        frontseat_cfg = self.cfg().frontseat_cfg
+        if frontseat_cfg.exit_on_error and self._driver.state() in _ERROR_STATES:
+            log.warning("error state detected (%s) and exit_on_error is true, so quitting",
+                        fs_pb.InterfaceState.Name(self._driver.state()))
+            self.quit(0)
+            return
+        self._publish_status_if_due(frontseat_cfg.status_period)
+
+    def _publish_status_if_due(self, period: float) -> None:
+        now = self._driver.now()
+        if self._next_status is not None and now < self._next_status:
+            return
+        self._next_status = now + period if self._next_status is None else max(self._next_status + period, now)
+        status = self._driver.status()
+        log.debug("status: %s", status)
+        self.interprocess().publish(groups.status, status)
+
+    def close(self) -> None:
+        super().close()
+        self._driver.close()
+
+
+def example_config(driver_module: object | None = None) -> str:
+    """A commented example configuration, with the driver's extension block when it declares one."""
+    from gateway.portal.config import example_config as message_example
+
+    extension = getattr(driver_module, "CONFIG_EXTENSION", None)
+    body = message_example(config_pb.Config.DESCRIPTOR, 1)
+    if extension is not None:
+        sub = message_example(extension.message_type, 2)
+        body += f"\n  [{extension.full_name}] {{  # the driver's settings\n{sub}\n  }}"
+    helm = message_example(gateway_pb.GobyMOOSGatewayConfig.MOOSConfig.DESCRIPTOR, 1)
+    helm = "\n".join(f"# {line}" for line in helm.splitlines())
+    return (
+        f"app {{\n{message_example(app_pb.FrontSeatInterfaceConfig.DESCRIPTOR.fields_by_name['app'].message_type, 1)}\n}}\n"
+        f"interprocess {{\n{message_example(app_pb.FrontSeatInterfaceConfig.DESCRIPTOR.fields_by_name['interprocess'].message_type, 1)}\n}}\n"
+        f"frontseat_cfg {{  # name and origin are set from interprocess.platform and app.geodesy\n{body}\n}}\n"
+        f"# [goby.moos.protobuf.moos_helm] {{  # run the MOOS helm interface (FrontSeatTranslation) thread\n"
+        f"{helm}\n# }}"
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Load the driver named by FRONTSEAT_DRIVER_LIBRARY, then run the interface (exit 1 if the driver fails)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    spec = os.environ.get(ENV_VAR)
+    if not spec:
+        print(
+            f"Environment variable {ENV_VAR} must be set with the name of the driver library to use "
+            "(an entry point such as basic_simulator, a dotted module, or a .py file).",
+            file=sys.stderr,
+        )
+        return 1
+    print(f"Loading frontseat driver library: {spec}", file=sys.stderr)
+    try:
+        module = load_driver_library(spec)
+        factory = driver_factory(module, spec)
+    except DriverLoadError as exc:
+        print(f"frontseat-interface: {exc}", file=sys.stderr)
+        return 1
+    if "-e" in argv or "--example_config" in argv:
+        print(example_config(module))
+        return 0
+    return run_application(
+        partial(FrontSeatInterface, driver_factory=factory),
+        app_pb.FrontSeatInterfaceConfig,
+        argv,
+        prog="frontseat-interface",
+    )
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,177 @@
+"""Helpers for tests that need the basic frontseat simulator (ours and other areas').
+
+* :func:`running_simulator` starts ``frontseat-sim`` as a real subprocess on a free port (or a given one)
+  and stops it on exit;
+* :class:`SimClient` is a blocking line client for talking to it byte for byte;
+* :func:`basic_simulator_frontseat_cfg` writes the interface's ``frontseat_cfg`` for it;
+* :func:`wait_until` polls a condition (never assert on a fixed sleep).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import TypeVar
+
+T = TypeVar("T")
+
+DELIMITER = b"\r\n"
+
+
+def wait_until(condition: Callable[[], T], timeout: float = 20.0, interval: float = 0.02, what: str = "") -> T:
+    """Poll ``condition`` until it returns something truthy (returned); AssertionError after ``timeout`` s."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = condition()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what or condition}")
+        time.sleep(interval)
+
+
+def free_tcp_port() -> int:
+    """A port that was free a moment ago on 127.0.0.1."""
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+@dataclass
+class SimulatorProcess:
+    """A running ``frontseat-sim`` subprocess."""
+
+    process: subprocess.Popen[str]
+    host: str
+    port: int
+
+    def stop(self, kill: bool = False) -> None:
+        """SIGTERM (or SIGKILL) it and wait; idempotent."""
+        if self.process.poll() is None:
+            self.process.kill() if kill else self.process.terminate()
+            try:
+                self.process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait(timeout=10)
+        if self.process.stdout is not None:
+            self.process.stdout.close()
+
+
+def start_simulator(port: int = 0, verbosity: int = 0, timeout: float = 30.0) -> SimulatorProcess:
+    """Start ``python -m frontseat.simulator.server <port>`` and wait until it listens."""
+    args = [sys.executable, "-m", "frontseat.simulator.server", str(port)] + (["-" + "v" * verbosity] if verbosity else [])
+    process = subprocess.Popen(args, stdout=subprocess.PIPE, text=True, env=dict(os.environ, PYTHONUNBUFFERED="1"))
+    assert process.stdout is not None
+    line = ""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        line = process.stdout.readline()
+        if "listening on" in line or not line:
+            break
+    if "listening on" not in line:
+        process.kill()
+        process.wait(timeout=10)
+        process.stdout.close()
+        raise RuntimeError(f"frontseat-sim did not start (exit {process.returncode}, said {line!r})")
+    host, _, bound = line.rsplit(" ", 1)[1].strip().rpartition(":")
+    return SimulatorProcess(process, host, int(bound))
+
+
+@contextlib.contextmanager
+def running_simulator(port: int = 0, verbosity: int = 0) -> Iterator[SimulatorProcess]:
+    """Context manager: a ``frontseat-sim`` subprocess on ``port`` (0: a free one), stopped on exit."""
+    sim = start_simulator(port, verbosity)
+    try:
+        yield sim
+    finally:
+        sim.stop()
+
+
+class SimClient:
+    """A blocking client of the simulator's line protocol, for tests."""
+
+    def __init__(self, port: int, host: str = "127.0.0.1", timeout: float = 20.0) -> None:
+        self.sock = socket.create_connection((host, port), timeout=timeout)
+        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._buffer = bytearray()
+
+    def send(self, *lines: str) -> None:
+        """Send each line with ``\\r\\n`` (all in one write)."""
+        self.sock.sendall(b"".join(line.encode() + DELIMITER for line in lines))
+
+    def send_bytes(self, data: bytes) -> None:
+        self.sock.sendall(data)
+
+    def read_line(self, timeout: float = 20.0) -> str:
+        """The next line (without ``\\r\\n``); TimeoutError if none arrives in time."""
+        deadline = time.monotonic() + timeout
+        while (end := self._buffer.find(DELIMITER)) < 0:
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                raise TimeoutError("no line from the simulator")
+            self.sock.settimeout(remaining)
+            chunk = self.sock.recv(65536)
+            if not chunk:
+                raise ConnectionError("simulator closed the connection")
+            self._buffer += chunk
+        line = bytes(self._buffer[:end]).decode()
+        del self._buffer[: end + len(DELIMITER)]
+        return line
+
+    def read_until(self, predicate: Callable[[str], bool], timeout: float = 20.0) -> list[str]:
+        """Lines up to and including the first one matching ``predicate``."""
+        deadline = time.monotonic() + timeout
+        lines: list[str] = []
+        while True:
+            lines.append(self.read_line(max(0.01, deadline - time.monotonic())))
+            if predicate(lines[-1]):
+                return lines
+
+    def close(self) -> None:
+        self.sock.close()
+
+    def __enter__(self) -> SimClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def basic_simulator_frontseat_cfg(
+    port: int,
+    *,
+    lat: float = 41.592344,
+    lon: float = -70.711260,
+    host: str = "127.0.0.1",
+    require_helm: bool = True,
+    helm_running_timeout: float = 10,
+    frontseat_connected_timeout: float = 10,
+    status_period: int = 5,
+    data_timeout: float = 10,
+    reconnect_interval: float = 1,
+    vehicle_type: str = "USV",
+) -> str:
+    """The ``frontseat_cfg { ... }`` text block for the basic simulator driver."""
+    return (
+        "frontseat_cfg {\n"
+        f"  require_helm: {str(require_helm).lower()}\n"
+        f"  helm_running_timeout: {helm_running_timeout}\n"
+        f"  frontseat_connected_timeout: {frontseat_connected_timeout}\n"
+        f"  status_period: {status_period}\n"
+        f"  type: {vehicle_type}\n"
+        "  [goby.middleware.frontseat.protobuf.basic_simulator_config] {\n"
+        f'    tcp_address: "{host}"\n'
+        f"    tcp_port: {port}\n"
+        f"    data_timeout: {data_timeout}\n"
+        f"    reconnect_interval: {reconnect_interval}\n"
+        f"    start {{ lat: {lat} lon: {lon} duration: 0 control_freq: 10 }}\n"
+        "  }\n"
+        "}\n"
+    )
