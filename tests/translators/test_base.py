@@ -1,0 +1,221 @@
+"""The Translator base with real parts: our MOOSDB (in-process), a goby-broker process, and the gateway
+application hosted in-process (``translators.testing.hosted_translators``)."""
+
+from __future__ import annotations
+
+import queue
+import re
+import threading
+from typing import Any
+
+import pytest
+
+from gateway.moos.message import NOTIFY, MoosMessage
+from gateway.moos.testing import collect_mail, connected_comms, running_moosdb
+from gateway.portal.testing import PortalClient, broker_process
+from gateway.protobuf.app_config_pb2 import AppConfig
+from translators.base import Translator
+from translators.moos_interface import TIME_VAR, MOOSInterface, time_string
+from translators.techniques import Technique
+from translators.testing import gateway_config, hosted_translators
+
+EVENTS: queue.Queue[tuple[str, int, Any]] = queue.Queue()
+
+
+class RecordingTranslator(Translator):
+    """Forwards IN (with the buffered B) to Goby and Goby's ``to_moos`` to OUT; records the thread of each call."""
+
+    def __init__(self, cfg) -> None:
+        super().__init__(cfg)
+        self.ident = threading.get_ident()
+        EVENTS.put(("constructed", self.ident, self.translator_name()))
+        self.moos().add_buffer("B")
+        self.moos().add_trigger("IN", self.on_in)
+        self.moos().add_trigger("IN", self.never)  # ignored: Goby keeps the first trigger
+        self.moos().add_wildcard_trigger("W_*", "poster", self.on_wild)
+        self.goby().interprocess().subscribe("to_moos", str, self.on_goby)
+
+    def on_in(self, msg) -> None:
+        b = self.moos().buffer().get("B")
+        EVENTS.put(("in", threading.get_ident(), msg.string()))
+        self.goby().interprocess().publish("from_moos", f"{msg.string()}|{b.double() if b else 'none'}")
+
+    def never(self, msg) -> None:
+        EVENTS.put(("duplicate", threading.get_ident(), msg.string()))
+
+    def on_wild(self, msg) -> None:
+        EVENTS.put(("wild", threading.get_ident(), msg.key()))
+
+    def on_goby(self, text: str) -> None:
+        EVENTS.put(("goby", threading.get_ident(), text))
+        self.moos().comms().notify("OUT", text.upper())
+
+
+class WakeOnlyTranslator(RecordingTranslator):
+    """Same, but its 10 Hz loop does nothing: MOOS mail can only reach it through the on-mail wake-up."""
+
+    def loop(self) -> None:
+        pass
+
+
+def _events_until(kind: str, count: int = 1, timeout: float = 20.0) -> list[tuple[str, int, Any]]:
+    seen: list[tuple[str, int, Any]] = []
+    got = 0
+    while got < count:
+        event = EVENTS.get(timeout=timeout)
+        seen.append(event)
+        got += event[0] == kind
+    return seen
+
+
+@pytest.fixture
+def infrastructure(tmp_path):
+    while not EVENTS.empty():
+        EVENTS.get_nowait()
+    with running_moosdb() as db, broker_process(tmp_path, platform="tb") as broker:
+        yield db, broker
+
+
+@pytest.mark.parametrize("translator_class", [RecordingTranslator, WakeOnlyTranslator])
+def test_both_directions_on_the_translator_thread(infrastructure, translator_class):
+    db, broker = infrastructure
+    cfg = gateway_config(db.port, broker.interprocess_config())
+    with PortalClient(broker.interprocess_config(), name="peer") as peer, \
+            connected_comms(db.port, "poster", register=["OUT"]) as poster:
+        from_moos = peer.collect("from_moos", str)
+        assert peer.wait_subscribed()
+        with hosted_translators(cfg, translator_class):
+            constructed = _events_until("constructed")[-1]
+            ident, name = constructed[1], constructed[2]
+            assert re.fullmatch(r"goby::moos::Translator::\d+", name)
+            # MOOS -> Goby: the buffered B rides along with the IN that follows it
+            seen: list[str] = []
+            for attempt in range(100):  # until the translator has registered (it connects asynchronously)
+                poster.notify("B", 7.5)
+                poster.notify("IN", f"hello{attempt}")
+                if peer.poll_until(lambda: bool(from_moos), 0.2):
+                    break
+            assert from_moos and from_moos[0].startswith("hello") and from_moos[0].endswith("|7.5")
+            events = _events_until("in")
+            assert all(e[1] == ident for e in events if e[0] in ("in", "duplicate"))
+            assert not [e for e in events if e[0] == "duplicate"]
+            # wildcard trigger: name and source globs
+            poster.notify("W_ONE", 1.0)
+            wild = [e for e in _events_until("wild") if e[0] == "wild"]
+            assert wild == [("wild", ident, "W_ONE")]
+            # Goby -> MOOS
+            peer.publish("to_moos", "abc")
+            out = collect_mail(poster, ["OUT"])
+            assert [m.string() for m in out] == ["ABC"]
+            goby_events = [e for e in _events_until("goby") if e[0] == "goby"]
+            assert goby_events == [("goby", ident, "abc")]
+            seen.append("ok")
+        assert seen == ["ok"]
+
+
+def test_translator_time_variable(infrastructure):
+    db, broker = infrastructure
+    cfg = gateway_config(db.port, broker.interprocess_config())
+    with connected_comms(db.port, "watcher", register=[TIME_VAR]) as watcher, \
+            hosted_translators(cfg, RecordingTranslator):
+        posts = collect_mail(watcher, [TIME_VAR], until=2, timeout=20)
+    assert len(posts) >= 2
+    for post in posts:
+        assert post.source().startswith("goby::moos::Translator::")
+        match = re.fullmatch(r"moostime=([0-9.e+]+),gobytime=([0-9.e+]+)\n", post.string())
+        assert match, post.string()
+        assert abs(float(match.group(1)) - float(match.group(2))) < 5
+    # about once a second (next publish time is incremented by 1 s, not reset)
+    assert posts[1].time() - posts[0].time() > 0.5
+
+
+def test_time_string_format():
+    assert time_string(1728590000.12345, 1728590000.12346) == "moostime=1728590000.12345,gobytime=1728590000.12346\n"
+
+
+class ScriptedComms:
+    """Test double for the MOOS client, used only where the real one cannot be made deterministic: it hands
+    ``handle_mail`` one prepared batch, so the buffer-before-trigger order within a batch can be asserted."""
+
+    def __init__(self, batch: list[MoosMessage]) -> None:
+        self.batch = batch
+        self.registered: list[tuple] = []
+        self.notified: list[tuple] = []
+
+    def set_on_connect_callback(self, f) -> bool:
+        return True
+
+    def set_on_mail_callback(self, f) -> bool:
+        return True
+
+    def register(self, *args) -> bool:
+        self.registered.append(args)
+        return True
+
+    def fetch(self) -> list[MoosMessage]:
+        batch, self.batch = self.batch, []
+        return batch
+
+    def notify(self, *args) -> bool:
+        self.notified.append(args)
+        return True
+
+    def notify_binary(self, *args) -> bool:
+        self.notified.append(("binary",) + args)
+        return True
+
+
+def _msg(key: str, value: float | str, src: str = "poster") -> MoosMessage:
+    msg = MoosMessage.string_msg(NOTIFY, key, value, 0.0) if isinstance(value, str) else \
+        MoosMessage.double_msg(NOTIFY, key, value, 0.0)
+    msg.raw_src = src.encode()
+    return msg
+
+
+def test_batch_fills_buffers_before_triggers_and_exact_before_wildcard():
+    batch = [_msg("SPEED", 1.0), _msg("HEADING", 10.0), _msg("HEADING", 20.0), _msg("SPEED", 2.0),
+             _msg("X_Y", "s", src="other")]
+    comms = ScriptedComms(batch)
+    iface = MOOSInterface(comms, call_soon=lambda fn: fn(), moos_time=lambda: 0.0, goby_time=lambda: 0.0)
+    calls: list[tuple[str, float | str]] = []
+    iface.add_buffer("HEADING")
+    iface.add_trigger("SPEED", lambda m: calls.append(("speed", iface.buffer()["HEADING"].double())))
+    iface.add_trigger("X_Y", lambda m: calls.append(("exact", m.string())))
+    iface.add_wildcard_trigger("X_*", "oth??", lambda m: calls.append(("wild", m.string())))
+    iface.add_wildcard_trigger("X_*", "poster", lambda m: calls.append(("wrong-app", m.string())))
+    assert iface.handle_mail() == 5
+    # both SPEED triggers see the last HEADING of the batch; the exact trigger of X_Y before its wildcard
+    assert calls == [("speed", 20.0), ("speed", 20.0), ("exact", "s"), ("wild", "s")]
+    assert ("HEADING", 0) in comms.registered and ("X_*", "poster", 0) in comms.registered
+    iface.register_all()
+    assert comms.registered.count(("SPEED", 0)) == 2
+
+
+def test_trigger_exception_does_not_stop_the_batch():
+    comms = ScriptedComms([_msg("A", 1.0), _msg("A", 2.0)])
+    iface = MOOSInterface(comms, call_soon=lambda fn: fn(), moos_time=lambda: 0.0, goby_time=lambda: 0.0)
+    seen: list[float] = []
+
+    def trigger(msg) -> None:
+        seen.append(msg.double())
+        raise RuntimeError("boom")
+
+    iface.add_trigger("A", trigger)
+    assert iface.handle_mail() == 2
+    assert seen == [1.0, 2.0]
+
+
+def test_notify_protobuf_uses_the_configured_technique():
+    comms = ScriptedComms([])
+    iface = MOOSInterface(comms, call_soon=lambda fn: fn(), moos_time=lambda: 0.0, goby_time=lambda: 0.0,
+                          technique=Technique.PREFIXED_PROTOBUF_TEXT_FORMAT)
+    iface.notify_protobuf("APP", AppConfig(name="x", loop_frequency=10))
+    assert comms.notified == [("APP", '@PB[goby.middleware.protobuf.AppConfig] name: "x" loop_frequency: 10 ')]
+    iface.notify_protobuf("BIN", AppConfig(name="x"), Technique.PROTOBUF_NATIVE_ENCODED)
+    assert comms.notified[-1] == ("binary", "BIN", AppConfig(name="x").SerializeToString())
+    parsed = iface.parse_protobuf(_msg("APP", comms.notified[0][1]), AppConfig())
+    assert parsed == AppConfig(name="x", loop_frequency=10)
+    from translators.techniques import TechniqueError
+
+    with pytest.raises(TechniqueError, match="Non-PROTOBUF"):
+        iface.notify_protobuf("APP", AppConfig(), Technique.FORMAT)

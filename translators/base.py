@@ -1,0 +1,94 @@
+"""``Translator``: one Goby thread paired with one MOOS client -- the unit a gateway plugin launches.
+
+Why this shape (python-can's bridge is two listeners): the MOOS side (``moos()``: triggers, buffers, the
+client) and the Goby side (``goby()``: interprocess/interthread subscriptions) each forward into the other, and
+*every* callback of both sides runs on this translator's own thread, never concurrently, so translator code needs
+no locks.  MOOS mail is handled as soon as it arrives: the client's I/O thread only wakes this thread with
+``call_soon``; this thread then fetches and dispatches the batch (Goby waits for its next 10 Hz tick).
+
+Subclass, set up triggers and subscriptions in ``__init__``, and launch it from a plugin's ``load(gateway)``
+with ``gateway.launch_thread(MyTranslator)``.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+
+import gateway.moos as moos
+from gateway.portal import SimpleThread
+from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from translators.moos_interface import TIME_VAR, MOOSInterface
+
+log = logging.getLogger(__name__)
+
+LOOP_FREQUENCY_HZ = 10.0  # Goby hard-codes 10 Hz (poll_frequency is ignored); times the warp factor
+
+__all__ = ["LOOP_FREQUENCY_HZ", "TIME_VAR", "MOOSInterface", "Translator"]
+
+
+class Translator(SimpleThread):
+    """Base class for translators: ``goby()`` is the portal side, ``moos()`` the MOOS side.
+
+    Construct it on the thread that runs it (``MultiThreadApplication.launch_thread`` does).  The constructor
+    connects the MOOS client to ``cfg.moos.server:cfg.moos.port`` as :meth:`translator_name`; triggers and
+    buffers added before or after the connection are (re-)registered on every connect.
+
+    ``comms_kind`` picks the client (``"ours"``, ``"pymoos"``, ``"auto"``; default ``GOBY_MOOS_CLIENT`` or ours),
+    see ``gateway.moos.make_comms``.
+    """
+
+    def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None) -> None:
+        super().__init__(cfg, LOOP_FREQUENCY_HZ, index)
+        self._name = f"goby::moos::Translator::{threading.get_ident()}"
+        sim = cfg.app.simulation.time
+        if sim.use_sim_time:
+            moos.set_moos_timewarp(float(sim.warp_factor))  # process-global, as Goby's SetMOOSTimeWarp
+        comms = moos.make_comms(comms_kind)
+        clock = self.context.clock
+        self._moos = MOOSInterface(
+            comms,
+            self.call_soon,
+            moos_time=moos.time,
+            goby_time=clock.now,
+            technique=cfg.moos.moos_parser_technique,
+        )
+        comms.run(cfg.moos.server, cfg.moos.port, self._name)
+        log.info("%s: MOOS client started for %s:%d", self._name, cfg.moos.server, cfg.moos.port)
+
+    def goby(self) -> Translator:
+        """The Goby side: ``goby().interprocess()`` / ``goby().interthread()`` publish and subscribe.
+
+        Subscription callbacks run on this translator's thread (the same thread as every MOOS trigger).
+        """
+        return self
+
+    def moos(self) -> MOOSInterface:
+        """The MOOS side: ``add_trigger``, ``add_wildcard_trigger``, ``add_buffer``, ``buffer()``, ``comms()``."""
+        return self._moos
+
+    def translator_name(self) -> str:
+        """``goby::moos::Translator::<thread id>``: this translator's MOOS client name (unique per thread)."""
+        return self._name
+
+    def loop(self) -> None:
+        """10 Hz x warp: posts ``GOBY_MOOS_TRANSLATOR_TIME`` about once a second and fetches leftover mail.
+
+        Subclasses that override ``loop`` must call ``super().loop()``.
+        """
+        self._moos.loop()
+
+    def close(self) -> None:
+        """Close the MOOS client (flushing queued notifies), then the Goby transports; idempotent."""
+        try:
+            self._moos.close()
+        finally:
+            super().close()
+
+    def cfg(self) -> GobyMOOSGatewayConfig:  # narrowed type for translator code
+        return super().cfg()
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__qualname__} {self._name}>"
+
+

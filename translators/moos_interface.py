@@ -1,0 +1,212 @@
+"""``MOOSInterface``: the MOOS side of one Translator -- its client, triggers, buffers and time variable.
+
+Why a separate object: it mirrors Goby's ``TranslatorBase::MOOSInterface`` (``moos().add_trigger(...)``) and
+keeps the MOOS bookkeeping apart from the Goby thread.  Threading contract: every method here is called on the
+owning translator's thread, and every trigger runs there.  The client's own I/O thread only *wakes* that thread
+(through ``call_soon``); it never touches the triggers, buffers or translator state.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable
+from typing import Any
+
+from gateway.moos.wildcard import wild_match
+from translators.techniques import Technique, is_binary, parse, serialize
+
+log = logging.getLogger(__name__)
+
+TIME_VAR = "GOBY_MOOS_TRANSLATOR_TIME"
+TIME_PUBLISH_PERIOD_S = 1.0
+
+MoosCallback = Callable[[Any], None]
+
+
+def time_string(moos_time: float, goby_time: float) -> str:
+    """The ``GOBY_MOOS_TRANSLATOR_TIME`` value: ``moostime=<%.15g>,gobytime=<%.15g>`` and a newline, as Goby."""
+    return f"moostime={moos_time:.15g},gobytime={goby_time:.15g}\n"
+
+
+class MOOSInterface:
+    """Triggers, buffers and the client of one translator (Goby's ``MOOSInterface``).
+
+    ``call_soon`` is the owner thread's thread-safe scheduler; ``moos_time``/``goby_time`` return MOOS time and
+    (warped) Goby time in seconds.  Nothing is unregistered: as in Goby there is no unsubscribe.
+    """
+
+    def __init__(
+        self,
+        comms: Any,
+        call_soon: Callable[[Callable[[], Any]], None],
+        moos_time: Callable[[], float],
+        goby_time: Callable[[], float],
+        technique: int = Technique.PREFIXED_PROTOBUF_TEXT_FORMAT,
+    ) -> None:
+        self._comms = comms
+        self._call_soon = call_soon
+        self._moos_time = moos_time
+        self._goby_time = goby_time
+        self.technique = Technique(technique)
+        self._triggers: dict[str, MoosCallback] = {}
+        self._wildcards: dict[tuple[str, str], MoosCallback] = {}
+        self._buffer_vars: set[str] = set()
+        self._buffer: dict[str, Any] = {}
+        self._next_time_publish = goby_time()
+        self._wake_lock = threading.Lock()
+        self._mail_pending = False
+        self._closed = False
+        self.mail_batches = 0  # how many fetch batches were handled (for tests and benchmarks)
+        comms.set_on_connect_callback(self._on_connect_io)
+        comms.set_on_mail_callback(self._on_mail_io)
+
+    # ------------------------------------------------------------------------------ translator API
+    def comms(self) -> Any:
+        """The pymoos-compatible client (``notify``, ``notify_binary``, ``register``, ...); thread-safe."""
+        return self._comms
+
+    def add_trigger(self, var: str, func: MoosCallback) -> None:
+        """Call ``func(msg)`` for every ``var`` mail, on the translator's thread.
+
+        A second trigger for the same variable is ignored (Goby keeps the first); we log a warning.
+        """
+        if var in self._triggers:
+            log.warning("a trigger for MOOS variable %s exists already; keeping the first (as Goby)", var)
+            return
+        self._triggers[var] = func
+        self._comms.register(var, 0)
+        log.debug("Subscribed for MOOS variable: %s", var)
+
+    def add_wildcard_trigger(self, var_wildcard: str, app_wildcard: str, func: MoosCallback) -> None:
+        """Call ``func(msg)`` on the translator's thread for mail whose name and source match the MOOS globs
+        (``*``, ``?``).  Wildcard triggers fire after the exact trigger of the same message, in the order added."""
+        key = (var_wildcard, app_wildcard)
+        if key in self._wildcards:
+            log.warning("wildcard trigger %s/%s exists already; keeping the first (as Goby)", *key)
+            return
+        self._wildcards[key] = func
+        self._comms.register(var_wildcard, app_wildcard, 0)
+        log.debug("Subscribed for MOOS wildcard: variable: %s, app: %s", var_wildcard, app_wildcard)
+
+    def add_buffer(self, var: str) -> None:
+        """Keep the latest ``var`` message in :meth:`buffer` (filled for a whole batch before any trigger runs)."""
+        self._buffer_vars.add(var)
+        self._comms.register(var, 0)
+
+    def buffer(self) -> dict[str, Any]:
+        """Latest message per buffered variable; translator code may read and delete entries (same thread)."""
+        return self._buffer
+
+    def notify_protobuf(self, var: str, msg: Any, technique: int | None = None) -> bool:
+        """Publish ``msg`` on ``var`` in the gateway's technique (``moos.moos_parser_technique``) or ``technique``.
+
+        Binary techniques go out with ``notify_binary``.  Goby refuses the key=value and format techniques here
+        (they need a format/algorithm set); so do we (TechniqueError).
+        """
+        chosen = self._protobuf_technique(technique)
+        value = serialize(msg, chosen)
+        if is_binary(chosen):
+            return self._comms.notify_binary(var, value)
+        return self._comms.notify(var, value)
+
+    def parse_protobuf(self, moos_msg: Any, msg: Any, technique: int | None = None) -> Any:
+        """Parse a MOOS message's value into ``msg`` with the gateway's technique; returns ``msg``."""
+        chosen = self._protobuf_technique(technique)
+        value = moos_msg.binary_data() if moos_msg.is_binary() else moos_msg.string()
+        return parse(value, msg, chosen)
+
+    def _protobuf_technique(self, technique: int | None) -> Technique:
+        from translators.techniques import TechniqueError
+
+        chosen = self.technique if technique is None else Technique(technique)
+        if chosen in (Technique.COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS, Technique.FORMAT):
+            raise TechniqueError(f"Non-PROTOBUF techniques are not supported for 'moos_parser_technique': "
+                                 f"{chosen.proto_name}")
+        return chosen
+
+    # ------------------------------------------------------------------------------ owner thread
+    def loop(self) -> None:
+        """The 10 Hz tick: post the time variable about once a second, and fetch any mail left (safety net)."""
+        now = self._goby_time()
+        if now > self._next_time_publish:
+            self._comms.notify(TIME_VAR, time_string(self._moos_time(), now))
+            self._next_time_publish += TIME_PUBLISH_PERIOD_S
+            if self._next_time_publish < now - TIME_PUBLISH_PERIOD_S:  # e.g. after a long stall: do not burst
+                self._next_time_publish = now
+        self.handle_mail()
+
+    def handle_mail(self) -> int:
+        """Fetch everything received and dispatch it: buffers for the whole batch first, then per message the
+        exact trigger and the wildcard triggers.  Returns the number of messages handled."""
+        with self._wake_lock:
+            self._mail_pending = False  # cleared *before* fetching, so later mail schedules another call
+        mail = self._comms.fetch()
+        if not mail:
+            return 0
+        self.mail_batches += 1
+        buffer_vars, buffer = self._buffer_vars, self._buffer
+        for msg in mail:
+            key = msg.key()
+            if key in buffer_vars:
+                buffer[key] = msg
+        triggers, wildcards = self._triggers, self._wildcards
+        for msg in mail:
+            func = triggers.get(msg.key())
+            if func is not None:
+                self._run(func, msg)
+            if wildcards:
+                self._run_wildcards(msg)
+        return len(mail)
+
+    def _run_wildcards(self, msg: Any) -> None:
+        key, source = msg.key().encode("utf-8", "surrogateescape"), msg.source().encode("utf-8", "surrogateescape")
+        for (var_wildcard, app_wildcard), func in list(self._wildcards.items()):
+            if wild_match(var_wildcard.encode(), key) and wild_match(app_wildcard.encode(), source):
+                self._run(func, msg)
+
+    def _run(self, func: MoosCallback, msg: Any) -> None:
+        try:
+            func(msg)
+        except Exception:
+            log.exception("MOOS trigger for %s raised; carrying on with the next message", msg.key())
+
+    def register_all(self) -> None:
+        """(Re-)register every trigger, buffer and wildcard; runs on the owner thread after each connect."""
+        for var in self._triggers:
+            self._comms.register(var, 0)
+        for var in self._buffer_vars:
+            self._comms.register(var, 0)
+        for var_wildcard, app_wildcard in self._wildcards:
+            self._comms.register(var_wildcard, app_wildcard, 0)
+        log.info("MOOS connected; registered %d trigger(s), %d buffer(s), %d wildcard(s)",
+                 len(self._triggers), len(self._buffer_vars), len(self._wildcards))
+
+    def close(self) -> None:
+        """Close the client (flushing queued notifies); idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        self._comms.close(True)
+
+    # ------------------------------------------------------------------------------ client I/O thread
+    def _on_connect_io(self) -> bool:
+        """Runs on the MOOS client's I/O thread: only schedules :meth:`register_all` on the owner thread."""
+        if not self._closed:
+            self._schedule(self.register_all)
+        return True
+
+    def _on_mail_io(self) -> bool:
+        """Runs on the MOOS client's I/O thread: wakes the owner once per burst (coalesced), never dispatches."""
+        with self._wake_lock:
+            if self._mail_pending or self._closed:
+                return True
+            self._mail_pending = True
+        self._schedule(self.handle_mail)
+        return True
+
+    def _schedule(self, fn: Callable[[], Any]) -> None:
+        try:
+            self._call_soon(fn)
+        except Exception:  # the owner is shutting down
+            log.debug("could not schedule %s on the translator thread", getattr(fn, "__name__", fn))

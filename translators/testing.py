@@ -1,0 +1,119 @@
+"""Test helpers for translators: host translator classes in-process as the gateway does, or run ``moos-gateway``
+as a process with plugins.  Pair them with ``gateway.moos.testing`` (a MOOSDB) and ``gateway.portal.testing``
+(a broker and a portal client)::
+
+    with running_moosdb() as db, broker_process(tmp_path) as broker:
+        cfg = gateway_config(db.port, broker.interprocess_config())
+        with hosted_translators(cfg, MyTranslator) as gateway:
+            ...   # talk to it with connected_comms(db.port, ...) and PortalClient(broker.interprocess_config())
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import subprocess
+import sys
+import threading
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+
+from gateway.moos_gateway import GobyMOOSGateway
+from gateway.plugins import ENV_VAR, Plugin
+from gateway.portal import ProcessContext, SimpleThread, use_context
+from gateway.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+
+
+def gateway_config(moos_port: int, interprocess: InterProcessPortalConfig | None = None,
+                   moos_server: str = "127.0.0.1", app_name: str = "goby_moos_gateway") -> GobyMOOSGatewayConfig:
+    """A ``GobyMOOSGatewayConfig`` pointing at a MOOSDB on ``moos_server:moos_port`` and a broker."""
+    cfg = GobyMOOSGatewayConfig()
+    cfg.app.name = app_name
+    cfg.moos.server = moos_server
+    cfg.moos.port = moos_port
+    if interprocess is not None:
+        cfg.interprocess.CopyFrom(interprocess)
+    return cfg
+
+
+@contextlib.contextmanager
+def hosted_translators(cfg: GobyMOOSGatewayConfig, *translator_classes: type[SimpleThread],
+                       hold_settle_s: float = 0.2) -> Iterator[GobyMOOSGateway]:
+    """Run a ``GobyMOOSGateway`` in this process whose one plugin launches ``translator_classes``.
+
+    The gateway's main thread runs on a background thread; on exit it quits and every translator is joined.
+    ``gateway.threads()`` gives the translator instances (inspect them only through thread-safe means).
+    """
+    def load(gateway: GobyMOOSGateway) -> None:
+        for cls in translator_classes:
+            gateway.launch_thread(cls)
+
+    plugin = Plugin("hosted_translators", None, load, None)
+    context = ProcessContext(cfg.interprocess, application=cfg.app.name or "goby_moos_gateway",
+                             hold_settle_s=hold_settle_s)
+    app: GobyMOOSGateway | None = None
+    runner: threading.Thread | None = None
+    try:
+        with use_context(context):
+            app = GobyMOOSGateway(cfg, [plugin])
+        runner = threading.Thread(target=app.run, name="hosted-gateway-main")
+        runner.start()
+        yield app
+    finally:
+        if app is not None:
+            app.quit()
+            if runner is not None:
+                runner.join(30)
+            app.close()
+        context.close()
+
+
+class GatewayProcess:
+    """``moos-gateway`` as a child process with ``GOBY_MOOS_GATEWAY_PLUGINS`` set; output goes to files."""
+
+    def __init__(self, workdir: str | os.PathLike[str], plugins: Iterable[str], config_text: str,
+                 env: dict[str, str] | None = None, extra_args: Iterable[str] = ()) -> None:
+        self.workdir = Path(workdir)
+        self.plugins = ":".join(plugins)
+        self.config_path = self.workdir / "gateway.pb.cfg"
+        self.config_path.write_text(config_text)
+        self.env = dict(os.environ if env is None else env)
+        self.env[ENV_VAR] = self.plugins
+        self.extra_args = list(extra_args)
+        self.proc: subprocess.Popen[bytes] | None = None
+        self.stdout_path = self.workdir / "gateway.out"
+        self.stderr_path = self.workdir / "gateway.err"
+
+    def start(self) -> GatewayProcess:
+        cmd = [sys.executable, "-m", "gateway.moos_gateway", str(self.config_path), *self.extra_args]
+        with open(self.stdout_path, "ab") as out, open(self.stderr_path, "ab") as err:
+            self.proc = subprocess.Popen(cmd, stdout=out, stderr=err, env=self.env, cwd=self.workdir)
+        return self
+
+    def wait(self, timeout: float = 60.0) -> int:
+        assert self.proc is not None
+        return self.proc.wait(timeout)
+
+    def stop(self, sig: int = signal.SIGTERM, timeout: float = 30.0) -> int | None:
+        """Send ``sig`` and wait (SIGKILL after ``timeout``); returns the exit code; idempotent."""
+        if self.proc is None:
+            return None
+        if self.proc.poll() is None:
+            self.proc.send_signal(sig)
+            try:
+                self.proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(10)
+        return self.proc.returncode
+
+    def stderr(self) -> str:
+        return self.stderr_path.read_text(errors="replace") if self.stderr_path.exists() else ""
+
+    def __enter__(self) -> GatewayProcess:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
