@@ -20,6 +20,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import uuid
 from collections.abc import Callable, Iterator
@@ -30,10 +31,12 @@ from typing import Any
 from google.protobuf import text_format
 
 from gateway.portal.broker_main import READY_PREFIX
-from gateway.portal.context import ProcessContext
+from gateway.portal.context import ProcessContext, use_context
 from gateway.portal.errors import PortalError
 from gateway.portal.group import GroupLike
 from gateway.portal.interprocess import InterProcessPortal
+from gateway.portal.thread import app_name_of, interprocess_config_of
+from gateway.portal.timeutil import SystemClock
 from gateway.portal.transports import ThreadTransports
 from gateway.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 
@@ -168,6 +171,49 @@ def broker_process(tmp_path: Path, platform: str = "test", tcp: bool = False,
         yield broker
 
 
+@contextmanager
+def running_app(app_class: Callable[[Any], Any], cfg: Any, *, hold_settle_s: float = 0.2,
+                clock: SystemClock | None = None, timeout_s: float = 30.0) -> Iterator[Any]:
+    """Construct ``app_class(cfg)`` and run it on a new thread of this process (with its own ``ProcessContext``);
+    yield the application; on exit ``quit()`` it, join, close.  A constructor error is raised here."""
+    context = ProcessContext(interprocess_config_of(cfg), application=app_name_of(cfg, "test_app"),
+                             hold_settle_s=hold_settle_s, clock=clock)
+    box: dict[str, Any] = {}
+    constructed = threading.Event()
+
+    def target() -> None:
+        with use_context(context):
+            try:
+                box["app"] = app = app_class(cfg)
+            except BaseException as exc:  # noqa: BLE001 - re-raised in the test thread
+                box["error"] = exc
+                constructed.set()
+                return
+            constructed.set()
+            try:
+                app.run()
+            except BaseException as exc:  # noqa: BLE001
+                box["run_error"] = exc
+            finally:
+                app.close()
+
+    thread = threading.Thread(target=target, name=f"app-{getattr(app_class, '__qualname__', 'app')}")
+    thread.start()
+    try:
+        if not constructed.wait(timeout_s):
+            raise PortalError(f"{app_class} was not constructed within {timeout_s} s")
+        if "error" in box:
+            raise box["error"]
+        yield box["app"]
+    finally:
+        if "app" in box:
+            box["app"].quit()
+        thread.join(timeout_s)
+        context.close()
+    if "run_error" in box:
+        raise box["run_error"]
+
+
 class PortalClient:
     """A portal driven by the test's own thread: publish, subscribe, and ``poll`` to run callbacks.
 
@@ -176,7 +222,10 @@ class PortalClient:
 
     def __init__(self, interprocess: InterProcessPortalConfig, name: str = "test_client",
                  hold_settle_s: float = 0.2) -> None:
-        self.context = ProcessContext(interprocess, client_name=name, application=name, hold_settle_s=hold_settle_s)
+        cfg = InterProcessPortalConfig()
+        cfg.CopyFrom(interprocess)
+        cfg.client_name = name
+        self.context = ProcessContext(cfg, client_name=name, application=name, hold_settle_s=hold_settle_s)
         self._transports = ThreadTransports(self.context, name)
         try:
             self.portal: InterProcessPortal = self._transports.interprocess()

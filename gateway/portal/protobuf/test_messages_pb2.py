@@ -26,7 +26,7 @@ from gateway.protobuf import app_config_pb2 as gateway_dot_protobuf_dot_app__con
 from gateway.protobuf import interprocess_config_pb2 as gateway_dot_protobuf_dot_interprocess__config__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n+gateway/portal/protobuf/test_messages.proto\x12\x19goby.test.zeromq.protobuf\x1a!gateway/protobuf/app_config.proto\x1a*gateway/protobuf/interprocess_config.proto\"n\n\x06Sample\x12\t\n\x01\x61\x18\x01 \x01(\x05\x12\x13\n\x0btemperature\x18\x02 \x01(\x01\x12\x10\n\x08salinity\x18\x03 \x01(\x01\x12\r\n\x05\x64\x65pth\x18\x04 \x01(\x01\x12\x12\n\nsent_micro\x18\x05 \x01(\x03\x12\x0f\n\x07padding\x18\x06 \x01(\x0c\"\x13\n\x06Widget\x12\t\n\x01\x62\x18\x01 \x01(\x05\"\xdb\x01\n\rTestAppConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x12\n\x04role\x18\x03 \x01(\t:\x04\x65\x63ho\x12\x11\n\x05\x63ount\x18\x04 \x01(\x05:\x02\x31\x30\x12\r\n\x05group\x18\x05 \x03(\t\x12\x1c\n\x0epublish_period\x18\x06 \x01(\x01:\x04\x30.05')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n+gateway/portal/protobuf/test_messages.proto\x12\x19goby.test.zeromq.protobuf\x1a!gateway/protobuf/app_config.proto\x1a*gateway/protobuf/interprocess_config.proto\"n\n\x06Sample\x12\t\n\x01\x61\x18\x01 \x01(\x05\x12\x13\n\x0btemperature\x18\x02 \x01(\x01\x12\x10\n\x08salinity\x18\x03 \x01(\x01\x12\r\n\x05\x64\x65pth\x18\x04 \x01(\x01\x12\x12\n\nsent_micro\x18\x05 \x01(\x03\x12\x0f\n\x07padding\x18\x06 \x01(\x0c\"\x13\n\x06Widget\x12\t\n\x01\x62\x18\x01 \x01(\x05\"\xdd\x01\n\x0fSampleAppConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x12\n\x04role\x18\x03 \x01(\t:\x04\x65\x63ho\x12\x11\n\x05\x63ount\x18\x04 \x01(\x05:\x02\x31\x30\x12\r\n\x05group\x18\x05 \x03(\t\x12\x1c\n\x0epublish_period\x18\x06 \x01(\x01:\x04\x30.05')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
@@ -37,6 +37,6 @@ if not _descriptor._USE_C_DESCRIPTORS:
   _globals['_SAMPLE']._serialized_end=263
   _globals['_WIDGET']._serialized_start=265
   _globals['_WIDGET']._serialized_end=284
-  _globals['_TESTAPPCONFIG']._serialized_start=287
-  _globals['_TESTAPPCONFIG']._serialized_end=506
+  _globals['_SAMPLEAPPCONFIG']._serialized_start=287
+  _globals['_SAMPLEAPPCONFIG']._serialized_end=508
 # @@protoc_insertion_point(module_scope)

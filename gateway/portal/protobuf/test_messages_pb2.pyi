@@ -30,7 +30,7 @@ class Widget(_message.Message):
     b: int
     def __init__(self, b: _Optional[int] = ...) -> None: ...
 
-class TestAppConfig(_message.Message):
+class SampleAppConfig(_message.Message):
     __slots__ = ("app", "interprocess", "role", "count", "group", "publish_period")
     APP_FIELD_NUMBER: _ClassVar[int]
     INTERPROCESS_FIELD_NUMBER: _ClassVar[int]

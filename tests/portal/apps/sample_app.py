@@ -1,6 +1,6 @@
 """Test applications run as real processes by tests/portal: ``python -m tests.portal.apps.sample_app``.
 
-Roles (``role:`` in TestAppConfig):
+Roles (``role:`` in SampleAppConfig):
 * ``tx``: publish ``count`` Samples (a = 1..count) on every ``group`` after the hold is released, then quit.
 * ``rx``: subscribe Sample on every ``group``; print ``RX <group> <a>`` per message; quit after ``count`` per group.
 * ``threads``: like rx, but subscribing from a launched SimpleThread; the main thread relays each message on
@@ -12,11 +12,11 @@ from __future__ import annotations
 import sys
 
 from gateway.portal import MultiThreadApplication, SimpleThread, SingleThreadApplication, run_application
-from gateway.portal.protobuf.test_messages_pb2 import Sample, TestAppConfig
+from gateway.portal.protobuf.test_messages_pb2 import Sample, SampleAppConfig
 
 
 class TxApp(SingleThreadApplication):
-    def __init__(self, cfg: TestAppConfig) -> None:
+    def __init__(self, cfg: SampleAppConfig) -> None:
         super().__init__(cfg, loop_frequency_hz=1.0 / cfg.publish_period)
         self.sent = 0
 
@@ -33,7 +33,7 @@ class TxApp(SingleThreadApplication):
 
 
 class RxApp(SingleThreadApplication):
-    def __init__(self, cfg: TestAppConfig) -> None:
+    def __init__(self, cfg: SampleAppConfig) -> None:
         super().__init__(cfg, loop_frequency_hz=10)
         self.counts = {g: 0 for g in cfg.group}
         for group in cfg.group:
@@ -48,7 +48,7 @@ class RxApp(SingleThreadApplication):
 
 
 class Printer(SimpleThread):
-    def __init__(self, cfg: TestAppConfig) -> None:
+    def __init__(self, cfg: SampleAppConfig) -> None:
         super().__init__(cfg)
         self.interthread().subscribe("relay", Sample, self.on_relay)
 
@@ -57,7 +57,7 @@ class Printer(SimpleThread):
 
 
 class Receiver(SimpleThread):
-    def __init__(self, cfg: TestAppConfig) -> None:
+    def __init__(self, cfg: SampleAppConfig) -> None:
         super().__init__(cfg, loop_frequency_hz=10)
         self.seen = 0
         for group in cfg.group:
@@ -69,7 +69,7 @@ class Receiver(SimpleThread):
 
 
 class ThreadsApp(MultiThreadApplication):
-    def __init__(self, cfg: TestAppConfig) -> None:
+    def __init__(self, cfg: SampleAppConfig) -> None:
         super().__init__(cfg, loop_frequency_hz=10)
         self.launch_thread(Printer)
         self.launch_thread(Receiver)
@@ -82,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
     role = next((a.split("=", 1)[1] for a in args if a.startswith("--role=")), "rx")
     args = [a for a in args if not a.startswith("--role=")]
-    return run_application(ROLES[role], TestAppConfig, args, prog=f"sample_{role}")
+    return run_application(ROLES[role], SampleAppConfig, args, prog=f"sample_{role}")
 
 
 if __name__ == "__main__":

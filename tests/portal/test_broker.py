@@ -1,0 +1,155 @@
+"""goby-broker: manager protocol, raw wire bytes, malformed input, TCP, refusing a second broker."""
+
+from __future__ import annotations
+
+import logging
+import os
+from pathlib import Path
+
+import pytest
+import zmq
+
+from gateway.portal import BrokerUnavailableError
+from gateway.portal.broker import Broker, BrokerError
+from gateway.portal.identifier import thread_id
+from gateway.portal.manager_client import request_endpoints
+from gateway.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
+from gateway.portal.protobuf.test_messages_pb2 import Sample
+from gateway.portal.testing import BrokerProcess, PortalClient, broker_process
+from gateway.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from gateway.protobuf.interprocess_zeromq_pb2 import (
+    PROVIDE_HOLD_STATE,
+    PROVIDE_PUB_SUB_SOCKETS,
+    ManagerRequest,
+    Socket,
+)
+
+SAMPLE = "goby.test.zeromq.protobuf.Sample"
+
+
+def test_manager_answers_like_gobyd() -> None:
+    cfg = GobyDaemonConfig()
+    cfg.interprocess.platform = "p"
+    cfg.hold.required_client.extend(["rx", "tx"])
+    broker = Broker(cfg)  # not started: respond() is pure
+    sockets = broker.respond(ManagerRequest(request=PROVIDE_PUB_SUB_SOCKETS, client_name="c", client_pid=7))
+    assert (sockets.client_name, sockets.client_pid) == ("c", 7)
+    assert sockets.publish_socket.socket_type == Socket.PUBLISH
+    assert sockets.publish_socket.transport == Socket.IPC
+    assert sockets.publish_socket.socket_name == "/tmp/goby_p.xsub"
+    assert sockets.subscribe_socket.socket_name == "/tmp/goby_p.xpub"
+    assert sockets.subscribe_socket.connect_or_bind == Socket.CONNECT
+    assert not sockets.HasField("hold")
+
+    def hold(name: str, ready: bool) -> bool:
+        req = ManagerRequest(request=PROVIDE_HOLD_STATE, client_name=name, client_pid=1, ready=ready)
+        return broker.respond(req).hold
+
+    assert hold("rx", False) is True
+    assert hold("rx", True) is True
+    assert hold("other", True) is True  # not a required client: does not count
+    assert hold("tx", True) is False
+    assert hold("late", False) is False  # once released, stays released
+
+
+def test_no_required_clients_means_no_hold() -> None:
+    broker = Broker(GobyDaemonConfig())
+    assert broker.respond(ManagerRequest(request=PROVIDE_HOLD_STATE, client_name="x", client_pid=1)).hold is False
+
+
+def test_broker_process_hands_out_ipc_endpoints(broker: BrokerProcess) -> None:
+    with zmq.Context() as zctx:
+        pub, sub, response = request_endpoints(zctx, broker.interprocess_config(), "probe", timeout_s=10)
+    assert pub == f"ipc://{broker.socket_base}.xsub"
+    assert sub == f"ipc://{broker.socket_base}.xpub"
+    assert response.client_pid == os.getpid()
+
+
+def test_raw_subscriber_sees_goby_identifier_bytes(broker: BrokerProcess) -> None:
+    with zmq.Context() as zctx, PortalClient(broker.interprocess_config(), "raw_test") as client:
+        raw = zctx.socket(zmq.SUB)
+        raw.setsockopt(zmq.LINGER, 0)
+        raw.connect(f"ipc://{broker.socket_base}.xpub")
+        raw.setsockopt(zmq.SUBSCRIBE, b"/widget1;1/")
+        assert client.wait_ready()
+        expected_head = f"/widget1;1/PROTOBUF/{SAMPLE}/{os.getpid()}/{thread_id()}/".encode() + b"\0"
+        msg = Sample(a=5, temperature=1.5)
+        frame = None
+        for _ in range(200):  # until the raw subscription has reached the publisher
+            client.publish("widget1;1", msg)
+            if raw.poll(50):
+                frame = raw.recv()
+                break
+        raw.close()
+    assert frame is not None
+    assert frame == expected_head + msg.SerializeToString()
+
+
+def test_malformed_frames_are_logged_and_the_client_keeps_serving(
+    broker: BrokerProcess, caplog: pytest.LogCaptureFixture
+) -> None:
+    caplog.set_level(logging.ERROR, logger="gateway.portal.interprocess")
+    with zmq.Context() as zctx, PortalClient(broker.interprocess_config(), "victim") as client:
+        got = client.collect("bad", Sample)
+        assert client.wait_subscribed()
+        raw = zctx.socket(zmq.PUB)
+        raw.setsockopt(zmq.LINGER, 0)
+        raw.connect(f"ipc://{broker.socket_base}.xsub")
+        prefix = f"/bad/PROTOBUF/{SAMPLE}/".encode()
+        bad_frames = [prefix + b"notapid/ab/\0x", prefix + b"1/ab/\0\xff\xff\xff", prefix + b"1/ab/"]
+        good = prefix + b"1/ab/\0" + Sample(a=99).SerializeToString()
+
+        def sent_and_received() -> bool:
+            for frame in (*bad_frames, good):
+                raw.send(frame)
+            return client.poll_until(lambda: bool(got), 0.1)
+
+        assert client.poll_until(sent_and_received, 20)
+        raw.close()
+    assert got[0].a == 99
+    text = caplog.text
+    assert "malformed identifier" in text
+    assert "cannot decode publication on bad (goby.test.zeromq.protobuf.Sample)" in text
+    assert "identifier followed by NUL" in text
+
+
+def test_second_broker_for_the_same_platform_is_refused(broker: BrokerProcess) -> None:
+    cfg = GobyDaemonConfig()
+    cfg.interprocess.CopyFrom(broker.interprocess_config())
+    with pytest.raises(BrokerError, match="another broker already serves"):
+        Broker(cfg).start()
+
+
+def test_no_broker_is_a_named_error(tmp_path: Path) -> None:
+    cfg = InterProcessPortalConfig(platform="nobody", socket_name=str(tmp_path / "nobody"), manager_timeout_seconds=1)
+    with pytest.raises(BrokerUnavailableError, match=f"No response from goby-broker at ipc://{tmp_path}/nobody.manager"):
+        PortalClient(cfg, "lonely")
+
+
+def test_tcp_transport_end_to_end(tmp_path: Path) -> None:
+    with broker_process(tmp_path, platform="tcp1", tcp=True) as tcp_broker:
+        cfg = tcp_broker.interprocess_config()
+        assert cfg.transport == InterProcessPortalConfig.TCP and cfg.tcp_port > 0
+        with PortalClient(cfg, "tcp_rx") as rx, PortalClient(cfg, "tcp_tx") as tx:
+            got = rx.collect("tcp_group", Sample)
+            assert rx.wait_subscribed() and tx.wait_ready()
+
+            def exchange() -> bool:
+                tx.publish("tcp_group", Sample(a=1))
+                return rx.poll_until(lambda: bool(got), 0.1)
+
+            assert rx.poll_until(exchange, 20)
+        assert got[0].a == 1
+
+
+def test_in_process_broker_start_stop_is_idempotent(tmp_path: Path) -> None:
+    cfg = GobyDaemonConfig()
+    cfg.interprocess.platform = "inproc"
+    cfg.interprocess.socket_name = str(tmp_path / "b")
+    cfg.router_threads = 1
+    with Broker(cfg) as broker:
+        assert broker.endpoints()["manager"] == f"ipc://{tmp_path}/b.manager"
+        with zmq.Context() as zctx:
+            request_endpoints(zctx, cfg.interprocess, "c", timeout_s=10)
+    broker.stop()
+    assert BrokerProcess(tmp_path, "x").stop() is None

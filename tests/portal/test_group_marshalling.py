@@ -1,0 +1,79 @@
+"""Groups and marshalling schemes against Goby's definitions (spec §4.1, §4.2)."""
+
+from __future__ import annotations
+
+import pytest
+
+from gateway.portal import Group, InvalidGroupError, MarshallingError, Scheme
+from gateway.portal.group import INVALID_NUMERIC_GROUP, as_group, check_named
+from gateway.portal.marshalling import (
+    default_scheme,
+    parse,
+    parse_dynamic,
+    scheme_from_string,
+    scheme_to_string,
+    serialize,
+    type_name,
+)
+from gateway.portal.protobuf.test_messages_pb2 import Sample
+
+
+def test_group_wire_strings() -> None:
+    assert str(Group("widget1", 1)) == "widget1;1"
+    assert str(Group("widget1")) == "widget1"
+    assert str(Group(numeric=7)) == "7"
+    assert str(Group()) == str(INVALID_NUMERIC_GROUP)
+
+
+def test_group_equality_follows_goby() -> None:
+    assert Group("a", 1) == Group("a", 1)
+    assert Group("a", 1) != Group("a", 2)
+    assert Group("a") != Group("b")
+    assert Group("", 3) == Group("x", 3)  # one side has no name: numerics decide
+    assert hash(Group("widget1", 1)) == hash("widget1;1")
+
+
+def test_group_parse_round_trip() -> None:
+    for text in ("nav", "widget1;1", "goby::middleware::frontseat::node_status", "a;b"):
+        assert str(Group.parse(text)) == text
+    assert as_group("w;2") == Group("w", 2)
+
+
+def test_group_validity() -> None:
+    with pytest.raises(InvalidGroupError, match="non-empty string for use on InterProcess"):
+        check_named(Group(numeric=3), "InterProcess")
+    with pytest.raises(InvalidGroupError):
+        Group("x", 2**32 - 1)
+
+
+def test_scheme_ids_and_names() -> None:
+    assert (Scheme.CSTR, Scheme.PROTOBUF, Scheme.DCCL, Scheme.JSON) == (0, 1, 2, 7)
+    assert (Scheme.ALL_SCHEMES, Scheme.NULL_SCHEME, Scheme.CXX_OBJECT, Scheme.MAVLINK) == (-2, -1, 5, 6)
+    assert scheme_to_string(1) == "PROTOBUF"
+    assert scheme_to_string(1000) == "1000"
+    assert scheme_from_string("DCCL") == 2
+    assert scheme_from_string("1000") == 1000
+    with pytest.raises(MarshallingError, match="unknown marshalling scheme 'BOGUS'"):
+        scheme_from_string("BOGUS")
+
+
+def test_protobuf_marshalling() -> None:
+    assert default_scheme(Sample) == Scheme.PROTOBUF
+    assert type_name(Sample, Scheme.PROTOBUF) == "goby.test.zeromq.protobuf.Sample"
+    msg = Sample(a=3, temperature=12.5)
+    data = serialize(msg, Scheme.PROTOBUF)
+    assert data == msg.SerializeToString()
+    assert parse(data, Scheme.PROTOBUF, Sample) == msg
+    assert parse_dynamic(data, Scheme.PROTOBUF, "goby.test.zeromq.protobuf.Sample") == msg
+    assert parse_dynamic(data, Scheme.PROTOBUF, "no.such.Type") == data  # unknown type: raw bytes
+    with pytest.raises(MarshallingError, match="cannot parse goby.test.zeromq.protobuf.Sample"):
+        parse(b"\xff\xff\xff", Scheme.PROTOBUF, Sample)
+
+
+def test_cstr_marshalling_keeps_goby_trailing_nul() -> None:
+    assert default_scheme(str) == Scheme.CSTR
+    assert type_name(str, Scheme.CSTR) == "CSTR"
+    assert serialize("HI", Scheme.CSTR) == b"HI\0"
+    assert parse(b"HI\0", Scheme.CSTR, str) == "HI"
+    with pytest.raises(MarshallingError):
+        default_scheme(dict)
