@@ -1,0 +1,1 @@
+"""The USV mission: settings, config generation, launch file, shore commands, demo."""

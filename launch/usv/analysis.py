@@ -1,0 +1,217 @@
+"""Judge a recorded USV mission: state timelines, what each command did, how well the vehicle loitered.
+
+Everything here is a pure function of a ``MissionRecord``; the demo prints it, the tests assert on it.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from launch.usv.geometry import Point, Polygon, parse_points, parse_polygon, radial_polygon
+from launch.usv.record import Event, MissionRecord, NavSample
+
+COMMAND_VARS = ("POLYGON_UPDATES", "DEPLOY_STATE")
+SETTLED_WITHIN_M = 15.0
+DEFAULT_RING = radial_polygon(0.0, 0.0, 200.0, 6)
+
+
+def transitions(events: list[Event]) -> list[tuple[float, str]]:
+    """(time, value) at each change of value, in order."""
+    out: list[tuple[float, str]] = []
+    for event in events:
+        if not out or out[-1][1] != event.value:
+            out.append((event.t, event.value))
+    return out
+
+
+def interface_timeline(record: MissionRecord) -> list[tuple[float, str]]:
+    return transitions(record.events_named("interface_state", source="interface"))
+
+
+def helm_timeline(record: MissionRecord) -> list[tuple[float, str]]:
+    return transitions(record.events_named("IVPHELM_STATE", source="moos"))
+
+
+def _from_helm(event: Event) -> bool:
+    # The helm's own `initialize` postings are not commands from shore.
+    return "helm" in event.origin.lower()
+
+
+@dataclass
+class CommandEffect:
+    """One shore command as MOOS saw it: the postings it produced, in arrival order."""
+
+    posts: list[Event] = field(default_factory=list)
+
+    @property
+    def t(self) -> float:
+        return self.posts[0].t
+
+    @property
+    def state(self) -> str:
+        states = [p.value for p in self.posts if p.name == "DEPLOY_STATE"]
+        return states[-1] if states else "?"
+
+    @property
+    def polygon_before_state(self) -> bool:
+        names = [p.name for p in self.posts]
+        return "POLYGON_UPDATES" in names and "DEPLOY_STATE" in names and (
+            names.index("POLYGON_UPDATES") < names.index("DEPLOY_STATE")
+        )
+
+    def describe(self) -> str:
+        return ", ".join(f"{p.name}={p.value}" for p in self.posts)
+
+
+def command_effects(record: MissionRecord) -> list[CommandEffect]:
+    """Group command postings: an optional POLYGON_UPDATES followed by DEPLOY_STATE is one command."""
+    effects: list[CommandEffect] = []
+    pending: CommandEffect | None = None
+    for event in record.snapshot()[1]:
+        if event.source != "moos" or event.name not in COMMAND_VARS or _from_helm(event):
+            continue
+        if pending is None:
+            pending = CommandEffect()
+        pending.posts.append(event)
+        if event.name == "DEPLOY_STATE":
+            effects.append(pending)
+            pending = None
+    if pending is not None:
+        effects.append(pending)
+    return effects
+
+
+@dataclass
+class LoiterPhase:
+    """An interval with DEPLOY_STATE=POLYGON and how the vehicle did on the ring in force."""
+
+    start: float
+    end: float
+    ring: Polygon
+    ring_source: str
+    settled_at: float | None = None
+    mean_distance: float | None = None
+    samples: int = 0
+    final_center_distance: float | None = None
+
+
+def _deploy_intervals(record: MissionRecord, end_time: float) -> list[tuple[float, float, str]]:
+    changes = transitions(record.events_named("DEPLOY_STATE", source="moos"))
+    out = []
+    for i, (t, state) in enumerate(changes):
+        t_end = changes[i + 1][0] if i + 1 < len(changes) else end_time
+        out.append((t, t_end, state))
+    return out
+
+
+def _position_at(nav: list[NavSample], t: float) -> Point | None:
+    before = [s for s in nav if s.t <= t]
+    sample = before[-1] if before else (nav[0] if nav else None)
+    return None if sample is None else (sample.x, sample.y)
+
+
+def _ring_for(record: MissionRecord, start: float, end: float, first: bool) -> tuple[Polygon, str]:
+    views = [e for e in record.events_named("VIEW_POLYGON", source="moos") if start <= e.t <= end]
+    for event in reversed(views):
+        polygon = parse_polygon(event.value)
+        if polygon is not None:
+            return polygon, "VIEW_POLYGON"
+    updates = [e for e in record.events_named("POLYGON_UPDATES", source="moos") if e.t <= start + 1.0]
+    ring = DEFAULT_RING
+    if updates:
+        parsed = parse_polygon(updates[-1].value)
+        ring = parsed or ring
+    if not first:
+        # BHV_Loiter with center_activate=true moves the ring to where the vehicle is when it activates.
+        where = _position_at(record.snapshot()[0], start)
+        if where is not None:
+            ring = ring.moved_to(where)
+    return ring, "derived"
+
+
+def loiter_phases(record: MissionRecord, end_time: float | None = None) -> list[LoiterPhase]:
+    nav = record.snapshot()[0]
+    if end_time is None:
+        end_time = nav[-1].t if nav else 0.0
+    phases = []
+    first = True
+    for start, end, state in _deploy_intervals(record, end_time):
+        if state != "POLYGON":
+            first = False
+            continue
+        ring, source = _ring_for(record, start, end, first)
+        phase = LoiterPhase(start, end, ring, source)
+        inside = [s for s in nav if start <= s.t <= end]
+        settled = next((s.t for s in inside if ring.distance((s.x, s.y)) <= SETTLED_WITHIN_M), None)
+        phase.settled_at = settled
+        if settled is not None:
+            after = [ring.distance((s.x, s.y)) for s in inside if s.t >= settled]
+            phase.samples = len(after)
+            phase.mean_distance = sum(after) / len(after)
+        if inside:
+            cx, cy = ring.center
+            phase.final_center_distance = math.hypot(inside[-1].x - cx, inside[-1].y - cy)
+        phases.append(phase)
+        first = False
+    return phases
+
+
+@dataclass
+class WaypointApproach:
+    """How the vehicle reacted to WAYPOINTS: heading error to the first waypoint and range change."""
+
+    t_command: float
+    waypoint: Point
+    start_range: float
+    min_range: float
+    start_heading_error: float | None
+    min_heading_error: float | None
+
+
+def bhv_waypoints(bhv_file: Path) -> list[Point]:
+    """The points of the first BHV_Waypoint block in a .bhv file (``points =`` or ``polygon =``)."""
+    text = re.sub(r"//[^\n]*", "", bhv_file.read_text())
+    block = re.search(r"BHV_Waypoint\s*\{(.*?)\}", text, flags=re.S)
+    if not block:
+        return []
+    match = re.search(r"^\s*(?:points|polygon)\s*=\s*(.+)$", block.group(1), flags=re.M)
+    return parse_points(match.group(1).strip()) if match else []
+
+
+def _bearing(a: Point, b: Point) -> float:
+    return math.degrees(math.atan2(b[0] - a[0], b[1] - a[1])) % 360.0
+
+
+def _angle_error(a: float, b: float) -> float:
+    return abs((a - b + 180.0) % 360.0 - 180.0)
+
+
+def waypoint_approach(
+    record: MissionRecord, waypoints: list[Point], window_s: float = 200.0
+) -> WaypointApproach | None:
+    """The vehicle's reaction in the ``window_s`` after the WAYPOINTS command reached MOOS."""
+    commands = [c for c in command_effects(record) if c.state == "WAYPOINTS"]
+    if not commands:
+        return None
+    seglists = [e for e in record.events_named("VIEW_SEGLIST", source="moos") if e.t >= commands[0].t]
+    points = parse_points(seglists[0].value) if seglists else []
+    target = (points or waypoints or [None])[0]
+    if target is None:
+        return None
+    t0 = commands[0].t
+    nav = [s for s in record.snapshot()[0] if t0 <= s.t <= t0 + window_s]
+    if not nav:
+        return None
+    ranges = [math.hypot(target[0] - s.x, target[1] - s.y) for s in nav]
+    errors = [_angle_error(s.heading, _bearing((s.x, s.y), target)) for s in nav if s.heading is not None]
+    return WaypointApproach(
+        t_command=t0,
+        waypoint=target,
+        start_range=ranges[0],
+        min_range=min(ranges),
+        start_heading_error=errors[0] if errors else None,
+        min_heading_error=min(errors) if errors else None,
+    )

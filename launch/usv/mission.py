@@ -1,0 +1,203 @@
+"""Run the USV mission from Python: launch usv.launch's processes, record them, stop them, check the logs.
+
+Used by the demo (``launch.usv.demo``) and the end-to-end test, so both run exactly what a user's
+``goby-launch launch/usv/usv.launch`` runs, with the same generated configs.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+import shutil
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from launch.errors import ConfigError, LaunchError, ProcessDiedError
+from launch.launcher import child_environment
+from launch.launchfile import parse_file
+from launch.process_group import ManagedProcess, ProcessGroup
+from launch.usv.record import MissionRecord, shifted
+from launch.usv.recorder import MoosRecorder, PortalRecorder, SimClock
+from launch.usv.settings import USV_DIR, UsvSettings
+
+log = logging.getLogger(__name__)
+
+LAUNCH_FILE = USV_DIR / "usv.launch"
+# Lines that count as an unexpected error in a process log.
+ERROR_PATTERN = re.compile(r"Traceback|\bERROR\b|\bCRITICAL\b|\bFATAL\b|Segmentation fault|core dumped", re.I)
+# Errors that are part of a normal run (none yet; add with a comment saying why).
+EXPECTED_ERRORS: tuple[re.Pattern[str], ...] = ()
+
+
+def choose_program(choice: str, real: str, ours: str) -> str:
+    """``auto``: the real MOOS-IvP program when it is on PATH, else ours; ``real``/``ours`` force one."""
+    if choice == "ours":
+        return ours
+    found = shutil.which(real)
+    if choice == "real":
+        if not found:
+            raise ConfigError(f"{real} was asked for but is not on PATH")
+        return real
+    if choice != "auto":
+        raise ConfigError(f"choose auto, real or ours, not {choice!r}")
+    return real if found else ours
+
+
+@dataclass
+class ProcessOutcome:
+    """How one process ended."""
+
+    name: str
+    returncode: int | None
+    clean: bool
+    log_path: Path
+
+
+@dataclass
+class MissionResult:
+    """Everything the demo prints and the test asserts: the record (t=0 at COMMAND) and the shutdown."""
+
+    record: MissionRecord
+    command_time: float | None
+    outcomes: list[ProcessOutcome] = field(default_factory=list)
+    log_errors: list[str] = field(default_factory=list)
+    failure: str | None = None
+
+
+def scan_logs(processes: list[ManagedProcess]) -> list[str]:
+    """Unexpected error lines, as ``name: line``, from every process log."""
+    found = []
+    for process in processes:
+        try:
+            lines = process.log_path.read_text(errors="replace").splitlines()
+        except OSError as exc:
+            found.append(f"{process.name}: log unreadable: {exc}")
+            continue
+        for line in lines:
+            if ERROR_PATTERN.search(line) and not any(p.search(line) for p in EXPECTED_ERRORS):
+                found.append(f"{process.name}: {line.strip()}")
+    return found
+
+
+class UsvMission:
+    """One run of the USV mission. Call ``start()``, then ``run()``, and always ``stop()`` (or use ``with``)."""
+
+    def __init__(
+        self,
+        settings: UsvSettings,
+        launch_file: Path = LAUNCH_FILE,
+        report: Callable[[str], None] = print,
+        launch_delay_s: float = 0.2,
+    ) -> None:
+        self.settings = settings
+        self.launch_file = launch_file
+        self.report = report
+        self.launch_delay_s = launch_delay_s
+        self.record = MissionRecord()
+        self.clock = SimClock(settings.warp)
+        self.group: ProcessGroup | None = None
+        self.moos: MoosRecorder | None = None
+        self.portal: PortalRecorder | None = None
+        self.command_time: float | None = None
+        self._stopped_result: MissionResult | None = None
+
+    def start(self) -> None:
+        """Start every process of the launch file, then the recorders."""
+        self.settings.run_dir.mkdir(parents=True, exist_ok=True)
+        env = child_environment() | self.settings.to_env()
+        self.group = ProcessGroup(
+            parse_file(self.launch_file).entries,
+            self.settings.log_dir,
+            platform=self.settings.platform,
+            launch_delay_s=self.launch_delay_s,
+            kill_timeout_s=10.0,
+            base_env=env,
+            cwd=USV_DIR,
+            report=self.report,
+        )
+        self.group.start()
+        self.moos = MoosRecorder(self.record, self.clock, self.settings)
+        self.moos.start()
+        self.portal = PortalRecorder(self.record, self.clock, self.settings)
+        self.portal.start()
+
+    def _check(self) -> None:
+        assert self.group is not None
+        died = self.group.check()
+        if died is not None:
+            raise ProcessDiedError(died.name, died.returncode, died.log_tail())
+        if self.portal is not None and self.portal.error is not None:
+            raise LaunchError(f"the demo's portal recorder failed: {self.portal.error}")
+
+    def poll(self) -> None:
+        """File new MOOS mail and check that every process is alive (raises ProcessDiedError)."""
+        if self.moos is not None:
+            self.moos.poll()
+        self._check()
+        if self.command_time is None:
+            states = self.record.events_named("interface_state", source="interface")
+            command = next((e.t for e in states if e.value == "INTERFACE_COMMAND"), None)
+            self.command_time = command
+
+    def wait_for_command(self, timeout_s: float = 120.0) -> float:
+        """Block until the frontseat interface reports INTERFACE_COMMAND; returns that sim time."""
+        deadline = time.monotonic() + timeout_s
+        while self.command_time is None:
+            self.poll()
+            if time.monotonic() > deadline:
+                seen = [e.value for e in self.record.events_named("interface_state")]
+                raise LaunchError(
+                    f"the frontseat interface did not reach INTERFACE_COMMAND within {timeout_s:g} s "
+                    f"(states seen: {', '.join(dict.fromkeys(seen)) or 'none'}; logs in {self.settings.log_dir})"
+                )
+            time.sleep(0.05)
+        return self.command_time
+
+    def run(
+        self,
+        duration_s: float | None,
+        progress: Callable[[float], None] | None = None,
+        progress_period_s: float = 2.0,
+        should_stop: Callable[[], bool] = lambda: False,
+    ) -> None:
+        """Run for ``duration_s`` sim seconds after COMMAND (None: until ``should_stop()``)."""
+        t0 = self.wait_for_command()
+        next_progress = 0.0
+        while not should_stop():
+            self.poll()
+            elapsed = self.clock.now() - t0
+            if progress is not None and time.monotonic() >= next_progress:
+                progress(elapsed)
+                next_progress = time.monotonic() + progress_period_s
+            if duration_s is not None and elapsed >= duration_s:
+                return
+            time.sleep(0.05)
+
+    def stop(self, failure: str | None = None) -> MissionResult:
+        """Stop the recorders, then the processes (reverse order); check exit statuses and logs."""
+        if self._stopped_result is not None:
+            return self._stopped_result
+        if self.moos is not None:
+            self.moos.poll()
+            self.moos.close()
+        if self.portal is not None:
+            self.portal.close()
+        outcomes: list[ProcessOutcome] = []
+        errors: list[str] = []
+        if self.group is not None:
+            self.group.stop()
+            for process in self.group.processes:
+                outcomes.append(ProcessOutcome(process.name, process.returncode, process.exited_cleanly,
+                                               process.log_path))
+            errors = scan_logs(self.group.processes)
+        t0 = self.command_time or 0.0
+        self._stopped_result = MissionResult(shifted(self.record, t0), self.command_time, outcomes, errors, failure)
+        return self._stopped_result
+
+    def __enter__(self) -> UsvMission:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()

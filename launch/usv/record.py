@@ -1,0 +1,114 @@
+"""What the demo saw during a mission, in sim seconds: the track and every interesting posting.
+
+The recorder (``launch.usv.recorder``) fills a ``MissionRecord`` from MOOS mail and portal messages;
+``launch.usv.analysis`` and ``launch.usv.plot`` read it. Kept free of I/O so analyses are testable
+with hand-made records.
+"""
+
+from __future__ import annotations
+
+import csv
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+
+
+@dataclass(frozen=True)
+class NavSample:
+    """One vehicle position (local metres), heading (deg) and speed (m/s) at sim time ``t``."""
+
+    t: float
+    x: float
+    y: float
+    heading: float | None = None
+    speed: float | None = None
+
+
+@dataclass(frozen=True)
+class Event:
+    """A posting seen at sim time ``t``: a MOOS variable, an interface state, a command acknowledgement."""
+
+    t: float
+    source: str  # "moos", "interface", "ack"
+    name: str
+    value: str
+    origin: str = ""  # the MOOS source (poster) or responder
+
+
+@dataclass
+class MissionRecord:
+    """The track and events, appended from recorder threads; read after the mission (or via snapshot())."""
+
+    nav: list[NavSample] = field(default_factory=list)
+    events: list[Event] = field(default_factory=list)
+    _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+    _x: float | None = field(default=None, repr=False)
+    _y: float | None = field(default=None, repr=False)
+    _heading: float | None = field(default=None, repr=False)
+    _speed: float | None = field(default=None, repr=False)
+
+    def add_nav(self, t: float, name: str, value: float) -> None:
+        """Fold one NAV_* value in; a position row is added (or its newest row updated) per update."""
+        with self._lock:
+            if name == "NAV_X":
+                self._x = value
+            elif name == "NAV_Y":
+                self._y = value
+            elif name == "NAV_HEADING":
+                self._heading = value
+            elif name == "NAV_SPEED":
+                self._speed = value
+            else:
+                return
+            if self._x is None or self._y is None:
+                return
+            sample = NavSample(t, self._x, self._y, self._heading, self._speed)
+            if self.nav and abs(self.nav[-1].t - t) < 1e-6:
+                self.nav[-1] = sample
+            else:
+                self.nav.append(sample)
+
+    def add_event(self, t: float, source: str, name: str, value: str, origin: str = "") -> None:
+        with self._lock:
+            self.events.append(Event(t, source, name, value, origin))
+
+    def snapshot(self) -> tuple[list[NavSample], list[Event]]:
+        with self._lock:
+            return list(self.nav), list(self.events)
+
+    def events_named(self, name: str, source: str | None = None) -> list[Event]:
+        with self._lock:
+            return [e for e in self.events if e.name == name and (source is None or e.source == source)]
+
+    def write_csv(self, track_path: Path, events_path: Path | None = None) -> None:
+        """track.csv: t,x,y,heading,speed,deploy_state; events.csv: t,source,name,value,origin."""
+        nav, events = self.snapshot()
+        deploy = [(e.t, e.value) for e in events if e.name == "DEPLOY_STATE"]
+        with open(track_path, "w", newline="") as out:
+            writer = csv.writer(out)
+            writer.writerow(["t", "x", "y", "heading", "speed", "deploy_state"])
+            index, state = 0, ""
+            for s in nav:
+                while index < len(deploy) and deploy[index][0] <= s.t:
+                    state = deploy[index][1]
+                    index += 1
+                writer.writerow([f"{s.t:.2f}", f"{s.x:.2f}", f"{s.y:.2f}", _fmt(s.heading), _fmt(s.speed), state])
+        if events_path is not None:
+            with open(events_path, "w", newline="") as out:
+                writer = csv.writer(out)
+                writer.writerow(["t", "source", "name", "value", "origin"])
+                for e in events:
+                    writer.writerow([f"{e.t:.2f}", e.source, e.name, e.value, e.origin])
+
+
+def _fmt(value: float | None) -> str:
+    return "" if value is None else f"{value:.2f}"
+
+
+def shifted(record: MissionRecord, dt: float) -> MissionRecord:
+    """A copy with every time moved by ``-dt`` (so t=0 can be the moment the helm took command)."""
+    nav, events = record.snapshot()
+    out = MissionRecord()
+    out.nav = [NavSample(s.t - dt, s.x, s.y, s.heading, s.speed) for s in nav]
+    out.events = [Event(e.t - dt, e.source, e.name, e.value, e.origin) for e in events]
+    return out

@@ -1,0 +1,158 @@
+"""Record a running USV mission from inside the demo process: a MOOS client and a portal subscriber.
+
+The MOOS side gives the track (NAV_*), the helm (IVPHELM_STATE, VIEW_*) and what commands posted
+(DEPLOY_STATE, POLYGON_UPDATES, with their posters); the portal side gives the frontseat interface's
+state (``goby::middleware::frontseat::status``) and the command acknowledgements. All events are stamped
+with one clock (sim seconds since the recorder started), so the two sides line up.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from typing import Any
+
+from frontseat import groups as frontseat_groups
+from frontseat.protobuf.frontseat_pb2 import InterfaceState, InterfaceStatus
+from gateway.moos import MoosClock, comms
+from gateway.portal import SimpleThread
+from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from launch.usv.record import MissionRecord
+from launch.usv.settings import UsvSettings
+
+log = logging.getLogger(__name__)
+
+NAV_VARS = ("NAV_X", "NAV_Y", "NAV_HEADING", "NAV_SPEED")
+EVENT_VARS = (
+    "DEPLOY_STATE",
+    "POLYGON_UPDATES",
+    "IVPHELM_STATE",
+    "VIEW_POLYGON",
+    "VIEW_SEGLIST",
+    "LOITER_MODE",
+    "WPT_INDEX",
+)
+
+
+class SimClock:
+    """Sim seconds since construction: real elapsed time times the warp."""
+
+    def __init__(self, warp: float) -> None:
+        self.warp = warp
+        self._start = time.monotonic()
+
+    def now(self) -> float:
+        return (time.monotonic() - self._start) * self.warp
+
+
+class MoosRecorder:
+    """A MOOS client registered for the mission's variables; ``poll()`` files new mail into the record.
+
+    ``poll()`` runs on the caller's thread (the demo's main loop); the client's own I/O thread only
+    queues mail, as the pymoos contract wants.
+    """
+
+    def __init__(self, record: MissionRecord, clock: SimClock, settings: UsvSettings, name: str = "uUsvDemoRecorder"):
+        self.record = record
+        self.clock = clock
+        self.settings = settings
+        self.name = name
+        self.comms = comms(clock=MoosClock(settings.warp))
+        self.comms.set_on_connect_callback(self._on_connect)
+        self.mail_count = 0
+
+    def _on_connect(self) -> bool:
+        for var in (*NAV_VARS, *EVENT_VARS):
+            self.comms.register(var, 0)
+        return True
+
+    def start(self) -> None:
+        self.comms.run("127.0.0.1", self.settings.moos_port, self.name)
+
+    def connected(self) -> bool:
+        return self.comms.is_connected()
+
+    def poll(self) -> int:
+        """File every message fetched since the last call; returns how many."""
+        messages = self.comms.fetch()
+        now = self.clock.now()
+        for msg in messages:
+            name = msg.key()
+            if name in NAV_VARS and msg.is_double():
+                self.record.add_nav(now, name, msg.double())
+            elif name in EVENT_VARS:
+                value = msg.string() if msg.is_string() else f"{msg.double():g}"
+                self.record.add_event(now, "moos", name, value, msg.source())
+        self.mail_count += len(messages)
+        return len(messages)
+
+    def close(self) -> None:
+        self.comms.close(True)
+
+
+class _PortalListener(SimpleThread):
+    """Subscribes to the interface status and (if the USV command path is installed) its acknowledgements."""
+
+    def __init__(self, cfg: GobyMOOSGatewayConfig, record: MissionRecord, clock: SimClock) -> None:
+        super().__init__(cfg)
+        self._record = record
+        self._clock = clock
+        self.interprocess().subscribe(frontseat_groups.status, InterfaceStatus, self._on_status)
+        try:
+            from translators.usv import groups as usv_groups
+            from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
+        except ImportError:  # the command path is optional for recording
+            return
+        self.interprocess().subscribe(usv_groups.usv_command_ack, USVCommandAck, self._on_ack)
+
+    def _on_status(self, status: InterfaceStatus) -> None:
+        if status.HasField("state"):
+            self._record.add_event(self._clock.now(), "interface", "interface_state", InterfaceState.Name(status.state))
+
+    def _on_ack(self, ack: Any) -> None:
+        stage = ack.DESCRIPTOR.fields_by_name["stage"].enum_type.values_by_number[ack.stage].name
+        posts = ";".join(ack.moos_post)
+        self._record.add_event(self._clock.now(), "ack", stage, posts or ack.error, ack.responder)
+
+
+class PortalRecorder:
+    """Runs the portal listener on its own thread (built there, as portal threads own their sockets)."""
+
+    def __init__(self, record: MissionRecord, clock: SimClock, settings: UsvSettings) -> None:
+        self._cfg = GobyMOOSGatewayConfig()
+        self._cfg.app.name = "usv-demo-recorder"
+        self._cfg.interprocess.platform = settings.platform
+        self._cfg.interprocess.socket_name = settings.ipc_base
+        self._record = record
+        self._clock = clock
+        self._listener: _PortalListener | None = None
+        self._lock = threading.Lock()
+        self._closing = False
+        self._thread = threading.Thread(target=self._run, name="usv-demo-portal", daemon=True)
+        self.error: BaseException | None = None
+
+    def _run(self) -> None:
+        try:
+            listener = _PortalListener(self._cfg, self._record, self._clock)
+            with self._lock:
+                self._listener = listener
+                if self._closing:
+                    listener.quit()
+            try:
+                listener.run()
+            finally:
+                listener.close()
+        except Exception as exc:  # reported by the demo; the thread must not die silently
+            self.error = exc
+            log.exception("portal recorder stopped")
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def close(self) -> None:
+        with self._lock:
+            self._closing = True
+            if self._listener is not None:
+                self._listener.quit()
+        self._thread.join(timeout=15)
