@@ -187,11 +187,12 @@ class LogicCondition:
         return self._root.variables()
 
     def _parse(self, text: str, whole: str) -> _Node:
+        original = text.strip()
         text = text.replace("\t", " ").replace(")", ") ").replace("(", " (").replace("$ (", "$(").strip()
         if not text:
             raise ConditionError(whole, text, "empty condition")
         if not _balanced(text):
-            raise ConditionError(whole, text, "unbalanced parentheses")
+            raise ConditionError(whole, original, "unbalanced parentheses")
         text = _prune_parens(text)
         if text.startswith("!") and _global_parens(text[1:]):
             return _Not(self._parse(text[1:], whole))
