@@ -1,0 +1,77 @@
+"""moos-gateway end to end: our MOOSDB, goby-broker and moos-gateway as processes, a plugin file in a temp dir.
+
+Checks both directions, buffering, the translator time variable, re-registration after the MOOSDB restarts,
+and a clean exit on SIGTERM/SIGINT.
+"""
+
+from __future__ import annotations
+
+import re
+import signal
+
+import pytest
+from gateway_plugin_sources import ECHO_PLUGIN
+
+from gateway.moos.testing import collect_mail, connected_comms, moosdb_process
+from gateway.portal.testing import PortalClient, broker_process
+from translators.moos_interface import TIME_VAR
+from translators.testing import GatewayProcess
+
+
+def _gateway_config(broker, moos_port: int) -> str:
+    return (f'app {{ name: "gw_under_test" }} interprocess {{ {broker.interprocess_text()} }} '
+            f'moos {{ server: "127.0.0.1" port: {moos_port} }}')
+
+
+def _moos_to_goby(poster, peer: PortalClient, got: list[str], tag: str, buffered: str) -> str:
+    """Notify B then IN until the translator (which connects asynchronously) forwards one; returns it."""
+    for attempt in range(150):
+        poster.notify("B", buffered)
+        poster.notify("IN", f"{tag}{attempt}")
+        if peer.poll_until(lambda: any(g.startswith(tag) for g in got), 0.2):
+            return next(g for g in got if g.startswith(tag))
+    raise AssertionError(f"no {tag} message came through the gateway; got {got}")
+
+
+@pytest.mark.parametrize("stop_signal", [signal.SIGTERM, signal.SIGINT])
+def test_gateway_process_end_to_end(tmp_path, stop_signal):
+    plugin = tmp_path / "echo_plugin.py"
+    plugin.write_text(ECHO_PLUGIN)
+    with moosdb_process(tmp_path) as db, broker_process(tmp_path, platform="gwe2e") as broker:
+        gateway = GatewayProcess(tmp_path, [str(plugin)], _gateway_config(broker, db.port), extra_args=["-v"])
+        with gateway, PortalClient(broker.interprocess_config(), name="peer") as peer, \
+                connected_comms(db.port, "poster", register=["OUT", "OUT_LOWER", TIME_VAR]) as poster:
+            from_moos = peer.collect("from_moos", str)
+            assert peer.wait_subscribed()
+
+            # MOOS -> Goby, with the buffered B of the same or an earlier batch
+            first = _moos_to_goby(poster, peer, from_moos, "before", "bee")
+            assert re.fullmatch(r"before\d+\|bee", first)
+
+            # Goby -> MOOS: one publication becomes two notifies
+            peer.publish("to_moos", "Hello")
+            out = collect_mail(poster, ["OUT", "OUT_LOWER"])
+            assert sorted((m.key(), m.string()) for m in out) == [("OUT", "HELLO"), ("OUT_LOWER", "hello")]
+            assert all(m.source().startswith("goby::moos::Translator::") for m in out)
+
+            # the translator's time variable, about once a second
+            times = collect_mail(poster, [TIME_VAR], until=2, timeout=20)
+            assert len(times) >= 2
+            assert re.fullmatch(r"moostime=[0-9.e+]+,gobytime=[0-9.e+]+\n", times[-1].string())
+
+            if stop_signal == signal.SIGTERM:
+                # the MOOSDB dies and comes back on the same port: the translator re-registers by itself
+                db.restart()
+                assert poster.wait_until_connected(20_000)
+                from_moos.clear()
+                again = _moos_to_goby(poster, peer, from_moos, "after", "bee2")
+                assert re.fullmatch(r"after\d+\|bee2", again)
+                for attempt in range(100):
+                    peer.publish("to_moos", f"Again{attempt}")
+                    if collect_mail(poster, ["OUT"], until=1, timeout=0.3):
+                        break
+                else:
+                    raise AssertionError("Goby -> MOOS did not resume after the MOOSDB restart")
+
+            assert gateway.stop(stop_signal) == 0, gateway.stderr()
+        assert "Traceback" not in gateway.stderr()
