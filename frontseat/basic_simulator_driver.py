@@ -158,5 +158,6 @@ class BasicSimulatorDriver(FrontSeatDriver):
         status.global_fix.lat = protocol.as_double(fields.get("LAT"))
         self.compute_missing(status)
         self.signal_data_from_frontseat.emit(data)
-        self._providing_data = True
-        self._last_data_time = self.now()
+        if self._fs_state != fs_pb.FRONTSEAT_NOT_CONNECTED:  # not a stale line read after the link dropped
+            self._providing_data = True
+            self._last_data_time = self.now()
