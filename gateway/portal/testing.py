@@ -290,3 +290,92 @@ class PortalClient:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+class AppProcess:
+    """An application subprocess whose stdout lines the test can wait for; stderr goes to ``log_path``.
+
+    ``wait_for("RX DONE")`` reads stdout until a line contains the text (or a predicate over the line holds).
+    ``stop()`` sends SIGTERM, then SIGKILL after ``timeout``; it is idempotent and returns the exit code.
+    """
+
+    def __init__(self, args: list[str], *, env: dict[str, str] | None = None, cwd: str | os.PathLike[str] | None = None,
+                 log_path: str | os.PathLike[str] | None = None) -> None:
+        self.args = args
+        self.log_path = Path(log_path) if log_path is not None else None
+        self._log = open(self.log_path, "w") if self.log_path is not None else subprocess.DEVNULL  # noqa: SIM115
+        self.process: subprocess.Popen[str] = subprocess.Popen(
+            args, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=self._log, text=True
+        )
+        self.lines: list[str] = []
+        self._selector = selectors.DefaultSelector()
+        assert self.process.stdout is not None
+        self._selector.register(self.process.stdout, selectors.EVENT_READ)
+        self.returncode: int | None = None
+
+    def read_available(self, timeout_s: float = 0.0) -> int:
+        """Read whatever stdout lines are ready (waiting up to ``timeout_s`` for the first)."""
+        count = 0
+        assert self.process.stdout is not None
+        while self._selector.select(timeout=timeout_s if count == 0 else 0):
+            line = self.process.stdout.readline()
+            if not line:
+                break
+            self.lines.append(line.rstrip("\n"))
+            count += 1
+        return count
+
+    def wait_for(self, what: str | Callable[[str], bool], timeout_s: float = 30.0) -> str | None:
+        """The first stdout line (already read or new) that contains ``what`` / satisfies it; None on timeout."""
+        test = (lambda line: what in line) if isinstance(what, str) else what
+        checked = 0
+        deadline = time.monotonic() + timeout_s
+        while True:
+            for line in self.lines[checked:]:
+                if test(line):
+                    return line
+            checked = len(self.lines)
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                return None
+            if not self.read_available(min(0.1, remaining)) and self.process.poll() is not None:
+                self.read_available(0)
+                if len(self.lines) == checked:
+                    return None
+
+    def wait(self, timeout_s: float = 30.0) -> int | None:
+        """Wait for the process to exit by itself (reading its output); None on timeout."""
+        deadline = time.monotonic() + timeout_s
+        while self.process.poll() is None and time.monotonic() < deadline:
+            self.read_available(0.1)
+        self.read_available(0)
+        return self.process.poll()
+
+    def stderr_text(self) -> str:
+        if self.log_path is None:
+            return ""
+        return self.log_path.read_text()
+
+    def stop(self, timeout_s: float = 10.0) -> int | None:
+        if self.returncode is None:
+            if self.process.poll() is None:
+                self.process.send_signal(signal.SIGTERM)
+                try:
+                    self.process.wait(timeout_s)
+                except subprocess.TimeoutExpired:
+                    self.process.kill()
+                    self.process.wait()
+            self.read_available(0)
+            self.returncode = self.process.returncode
+            self._selector.close()
+            assert self.process.stdout is not None
+            self.process.stdout.close()
+            if self._log is not subprocess.DEVNULL:
+                self._log.close()  # type: ignore[union-attr]
+        return self.returncode
+
+    def __enter__(self) -> AppProcess:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
