@@ -295,8 +295,8 @@ class comms:  # noqa: N801 - pymoos's class name
     def server_request(self, what: str, timeout: float = 2.0) -> list[MoosMessage]:
         """Send a ``Q`` request (``ALL``, ``PROC_SUMMARY``, ``VAR_SUMMARY``, ``DB_CLEAR``) and collect replies.
 
-        Replies (id -2) are taken out of the inbox; other mail stays for ``fetch``. Waits until ``timeout``
-        passes with no reply, or 0.2 s after the last reply.
+        Replies (id -2) are taken out of the inbox; other mail stays for ``fetch``. The DB sends all replies
+        to one request in one packet, so this returns as soon as they arrive (or ``[]`` after ``timeout``).
         """
         msg = MoosMessage(SERVER_REQUEST, STRING, msg_id=SERVER_REQUEST_ID, key=to_bytes(what), msg_time=self._clock.time())
         if not self._post(msg, assign_id=False):
@@ -311,7 +311,7 @@ class comms:  # noqa: N801 - pymoos's class name
                     self._inbox.clear()
                     self._inbox.extend(keep)
                     replies.extend(got)
-                    deadline = min(deadline, _time.monotonic() + 0.2)
+                    break
                 self._inbox_cond.wait(0.02)
         return replies
 

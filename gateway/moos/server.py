@@ -88,6 +88,8 @@ class MoosDB:
         client_timeout: float = 5.0,
         max_packet_bytes: int = DEFAULT_MAX_PACKET_BYTES,
         stall_timeout: float = 6.0,
+        handshake_timeout: float = HANDSHAKE_TIMEOUT_S,
+        high_water: int = HIGH_WATER,
     ) -> None:
         self.host = host
         self._requested_port = int(port)
@@ -95,6 +97,9 @@ class MoosDB:
         self.clock = MoosClock(time_warp)
         self.client_timeout = float(client_timeout)
         self.stall_timeout = float(stall_timeout)
+        self.handshake_timeout = float(handshake_timeout)
+        self.high_water = int(high_water)
+        self.low_water = min(LOW_WATER, self.high_water // 4)
         self.max_packet_bytes = max_packet_bytes
         self.db = MoosDatabase(community, self.clock)
         self._hostname = to_bytes(socket.gethostname())
@@ -384,7 +389,7 @@ class MoosDB:
         client.out.append(data)
         client.out_bytes += len(data)
         self._set_events(client)
-        if client.out_bytes > HIGH_WATER and client not in self._congested:
+        if client.out_bytes > self.high_water and client not in self._congested:
             self._congested.add(client)
             log.warning("client %s is not keeping up (%d bytes queued); pausing reads from all clients",
                         client.label(), client.out_bytes)
@@ -415,7 +420,7 @@ class MoosDB:
                 client.out[0] = chunk[sent:]
                 break
             client.out.popleft()
-        if client in self._congested and client.out_bytes < LOW_WATER:
+        if client in self._congested and client.out_bytes < self.low_water:
             self._congested.discard(client)
             if not self._congested:
                 self._set_paused(False)
@@ -437,8 +442,8 @@ class MoosDB:
     def _check_timeouts(self, now: float) -> None:
         for client in list(self._clients.values()):
             if client.state in (_PROTOCOL, _HELLO):
-                if now - client.accepted > HANDSHAKE_TIMEOUT_S:
-                    self._close(client, f"no handshake within {HANDSHAKE_TIMEOUT_S:g} s")
+                if now - client.accepted > self.handshake_timeout:
+                    self._close(client, f"no handshake within {self.handshake_timeout:g} s")
             elif client.out_bytes and now - client.last_progress > self.stall_timeout:
                 self._close(client, f"not reading: {client.out_bytes} bytes unsent for {self.stall_timeout:g} s")
             elif not self._paused and now - client.last_rx > self.client_timeout:

@@ -132,7 +132,11 @@ def moosdb_process(tmp_path: str | os.PathLike[str], community: str = "moos", wa
 @contextlib.contextmanager
 def connected_comms(port: int, name: str, register: Iterable[str] = (), host: str = "127.0.0.1",
                     asynchronous: bool = True, timeout: float = 10.0) -> Iterator[comms]:
-    """A :class:`comms` connected to ``host:port`` that (re)registers ``register`` on every connection."""
+    """A :class:`comms` connected to ``host:port`` that (re)registers ``register`` on every connection.
+
+    When it yields, the DB has processed the registrations (a server-request round trip confirms it), so
+    a test may publish at once without racing them.
+    """
     client = comms(asynchronous=asynchronous)
     names = list(register)
     client.set_on_connect_callback(lambda: [client.register(n, 0) for n in names])
@@ -140,6 +144,10 @@ def connected_comms(port: int, name: str, register: Iterable[str] = (), host: st
     try:
         if not client.wait_until_connected(timeout * 1000):
             raise TimeoutError(f"{name} did not connect to {host}:{port} within {timeout} s")
+        if names:
+            wait_for(lambda: all(client.is_registered_for(n) for n in names), timeout)
+            if not client.server_request("VAR_SUMMARY", timeout):
+                raise TimeoutError(f"{name}: the DB did not answer a server request within {timeout} s")
         yield client
     finally:
         client.close(True)
