@@ -1,0 +1,220 @@
+"""Threads and applications in one process: call_soon, interthread, launch/join, loop frequency with warp,
+interprocess from a non-main thread, loop errors, signals, and the interface registry."""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from gateway.portal import (
+    InvalidGroupError,
+    MultiThreadApplication,
+    SimpleThread,
+    SingleThreadApplication,
+    SystemClock,
+    ThreadError,
+)
+from gateway.portal.interface_registry import ENV_VAR, read_entries
+from gateway.portal.protobuf.test_messages_pb2 import Sample, SampleAppConfig
+from gateway.portal.testing import AppProcess, BrokerProcess, PortalClient, running_app
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def wait_until(predicate: Any, timeout_s: float = 20.0) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.01)
+    return True
+
+
+class Worker(SimpleThread):
+    """Records the thread its callbacks run on."""
+
+    def __init__(self, cfg: SampleAppConfig, group: str = "work") -> None:
+        super().__init__(cfg, loop_frequency_hz=0)
+        self.ident = threading.get_ident()
+        self.seen: list[tuple[int, int]] = []
+        self.interthread().subscribe(group, Sample, lambda m: self.seen.append((m.a, threading.get_ident())))
+
+
+def no_interprocess_cfg() -> Any:
+    """An app config type without an interprocess field, so the app needs no broker."""
+    from gateway.protobuf.app_config_pb2 import AppConfig
+
+    return AppConfig(name="standalone")
+
+
+class InterthreadOnly(MultiThreadApplication):
+    pass
+
+
+def test_call_soon_runs_on_owning_thread_and_wakes_it() -> None:
+    with running_app(InterthreadOnly, no_interprocess_cfg()) as app:
+        worker = app.launch_thread(Worker, SampleAppConfig())
+        where: list[int] = []
+        done = threading.Event()
+        start = time.monotonic()
+        worker.call_soon(lambda: (where.append(threading.get_ident()), done.set()))
+        assert done.wait(10)
+        elapsed = time.monotonic() - start
+        assert where == [worker.ident] != [threading.get_ident()]
+        assert elapsed < 1.0  # the thread has no loop: only the wake-up can have run it
+        worker.call_soon(lambda: 1 / 0)  # logged, the thread keeps serving
+        worker.call_soon(done.clear)
+        assert wait_until(lambda: not done.is_set())
+        assert app.join_thread(Worker) == 1
+
+
+def test_interthread_delivers_on_subscriber_threads_without_echo() -> None:
+    with running_app(InterthreadOnly, no_interprocess_cfg()) as app:
+        w1 = app.launch_thread(Worker, SampleAppConfig())
+        w2 = app.launch_thread(Worker, SampleAppConfig())
+        for a in range(1, 4):
+            w1.call_soon(lambda a=a: w1.interthread().publish("work", Sample(a=a)))
+        assert wait_until(lambda: len(w2.seen) == 3)
+        time.sleep(0.1)
+        assert [a for a, _ in w2.seen] == [1, 2, 3]
+        assert {t for _, t in w2.seen} == {w2.ident}
+        assert w1.seen == []  # the publisher does not get its own interthread publication
+        with pytest.raises(InvalidGroupError):
+            w1.interthread().publish("", Sample())
+
+
+class Broken(SimpleThread):
+    def __init__(self, cfg: Any) -> None:
+        raise RuntimeError("no hardware")
+
+
+class LoopFails(SimpleThread):
+    def __init__(self, cfg: Any) -> None:
+        super().__init__(cfg, loop_frequency_hz=50)
+
+    def loop(self) -> None:
+        raise RuntimeError("bug in loop")
+
+
+def test_launch_errors_and_loop_errors() -> None:
+    with running_app(InterthreadOnly, no_interprocess_cfg()) as app:
+        with pytest.raises(ThreadError, match="Broken failed to start: no hardware"):
+            app.launch_thread(Broken)
+        app.launch_thread(LoopFails)
+        assert wait_until(lambda: app.return_code == 1 and not app.alive)
+
+
+class Ticker(SingleThreadApplication):
+    def __init__(self, cfg: Any) -> None:
+        super().__init__(cfg, loop_frequency_hz=10)
+        self.ticks = 0
+
+    def loop(self) -> None:
+        self.ticks += 1
+
+
+def test_loop_frequency_is_multiplied_by_warp() -> None:
+    with running_app(Ticker, no_interprocess_cfg(), clock=SystemClock(True, 5)) as app:
+        assert app.effective_loop_frequency_hz() == 50
+        start, first = time.monotonic(), app.ticks
+        time.sleep(1.0)
+        rate = (app.ticks - first) / (time.monotonic() - start)
+    assert 20 < rate <= 55  # 10 Hz unwarped would be ~10
+
+
+def test_app_loop_frequency_config_overrides_code(broker: BrokerProcess) -> None:
+    cfg = SampleAppConfig()
+    cfg.app.loop_frequency = 2
+    cfg.interprocess.CopyFrom(broker.interprocess_config())
+    with running_app(Ticker, cfg) as app:
+        assert app.loop_frequency_hz == 2
+    with running_app(Ticker, no_interprocess_cfg()) as app:
+        assert app.loop_frequency_hz == 10
+
+
+class PortalThread(SimpleThread):
+    """Subscribes interprocess from a launched (non-main) thread."""
+
+    def __init__(self, cfg: SampleAppConfig) -> None:
+        super().__init__(cfg)
+        self.ident = threading.get_ident()
+        self.got: list[tuple[int, int]] = []
+        self.interprocess().subscribe("from_test", Sample, self.on_sample)
+
+    def on_sample(self, msg: Sample) -> None:
+        self.got.append((msg.a, threading.get_ident()))
+        self.interprocess().publish("from_thread", Sample(a=msg.a * 10))
+
+
+class PortalApp(MultiThreadApplication):
+    def __init__(self, cfg: SampleAppConfig) -> None:
+        super().__init__(cfg)
+        self.worker = self.launch_thread(PortalThread)
+
+
+def test_non_main_thread_uses_interprocess_with_callbacks_on_its_thread(broker: BrokerProcess) -> None:
+    cfg = SampleAppConfig()
+    cfg.app.name = "portal_app"
+    cfg.interprocess.CopyFrom(broker.interprocess_config())
+    with running_app(PortalApp, cfg) as app, PortalClient(broker.interprocess_config(), "pt_client") as client:
+        answers = client.collect("from_thread", Sample)
+        assert client.wait_subscribed()
+        assert wait_until(lambda: not app.interprocess().hold_state())
+        a = 0
+
+        def answered() -> bool:
+            nonlocal a
+            a += 1
+            client.publish("from_test", Sample(a=a))
+            return client.poll_until(lambda: bool(answers), 0.1)
+
+        assert client.poll_until(answered, 20)
+        worker = app.worker
+    assert {t for _, t in worker.got} == {worker.ident}
+    assert answers[0].a % 10 == 0
+    from gateway.portal import process_registry
+
+    entries = {(e.layer, e.direction, e.group, e.scheme, e.type, e.thread) for e in process_registry.entries()}
+    assert ("interprocess", "subscribe", "from_test", "PROTOBUF", "goby.test.zeromq.protobuf.Sample",
+            "PortalThread") in entries
+    assert ("interprocess", "publish", "from_thread", "PROTOBUF", "goby.test.zeromq.protobuf.Sample",
+            "PortalThread") in entries
+
+
+def test_sigterm_shuts_an_app_down_cleanly_and_writes_the_registry(broker: BrokerProcess, tmp_path: Path) -> None:
+    registry_file = tmp_path / "interfaces.json"
+    env = broker.env()
+    env[ENV_VAR] = str(registry_file)
+    cmd = [sys.executable, "-m", "tests.portal.apps.sample_app", "--role=rx", "-a", "sig_rx", "-v",
+           "--group", "sig", "--count", "1000"]
+    with AppProcess(cmd, env=env, cwd=REPO, log_path=tmp_path / "rx.log") as app:
+        with PortalClient(broker.interprocess_config(), "sig_tx") as tx:
+            assert tx.wait_ready()
+
+            def running() -> bool:
+                tx.publish("sig", Sample(a=1))
+                return app.wait_for("RX sig", 0.1) is not None
+
+            assert tx.poll_until(running, 30), app.stderr_text()
+        app.process.send_signal(signal.SIGTERM)
+        assert app.wait(20) == 0
+        assert "received SIGTERM; shutting down" in app.stderr_text()
+    entries = read_entries(registry_file)
+    assert any(e.direction == "subscribe" and e.group == "sig" and e.thread == "RxApp" and e.application == "sig_rx"
+               for e in entries)
+
+
+def test_example_config_of_an_app() -> None:
+    out = AppProcess([sys.executable, "-m", "tests.portal.apps.sample_app", "--role=rx", "--example_config"],
+                     cwd=REPO)
+    with out:
+        assert out.wait(30) == 0
+    text = "\n".join(out.lines)
+    assert "interprocess {" in text and "platform: \"default_goby_platform\"" in text
+    assert "role: \"echo\"" in text and "warp_factor: 1" in text
