@@ -1,0 +1,126 @@
+"""FrontSeatTranslation and NodeReportTranslation in moos-gateway, with a real MOOSDB and broker.
+
+node_status on interprocess -> NAV_* (and NODE_REPORT) in MOOS; DESIRED_* and IVPHELM_STATE posted in MOOS ->
+desired_course and helm_state on interprocess.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import pytest
+
+from frontseat import groups
+from frontseat.protobuf.frontseat_data_pb2 import USV, DesiredCourse, NodeStatus
+from frontseat.protobuf.frontseat_pb2 import HELM_DRIVE, HELM_NOT_RUNNING, HELM_PARK, HelmStateReport
+from gateway.moos.testing import connected_comms
+from gateway.portal.testing import PortalClient
+
+NAV_VARS = ["NAV_X", "NAV_Y", "NAV_LAT", "NAV_LONG", "NAV_DEPTH", "NAV_HEADING", "NAV_YAW", "NAV_SPEED",
+            "NAV_PITCH", "NAV_ROLL", "GPS_UPDATE_RECEIVED", "NODE_REPORT"]
+TIMEOUT_S = 30.0
+# ivp_helm.md §7.3, origin 43.8253, -70.3304: (60, -40) <-> (43.82494863, -70.32964602)
+REF_LAT, REF_LON, REF_X, REF_Y = 43.82494863, -70.32964602, 60.0, -40.0
+
+
+def node_status(stamp: float) -> NodeStatus:
+    status = NodeStatus(time=stamp, name="usv", type=USV)
+    status.global_fix.lat = REF_LAT
+    status.global_fix.lon = REF_LON
+    status.global_fix.depth = 0.5
+    status.pose.heading = 120.0
+    status.pose.pitch = 2.0
+    status.pose.roll = -3.0
+    status.speed.over_ground = 1.25
+    status.local_fix.x = 9999.0  # a wrong local fix: NAV_X/NAV_Y must come from lat/lon on the datum's grid
+    status.local_fix.y = 9999.0
+    return status
+
+
+def test_node_status_becomes_nav_variables_and_a_node_report(stack):
+    stamp = 1754431234.25
+    latest: dict[str, object] = {}
+    with connected_comms(stack.moos_port, "watch_nav", register=NAV_VARS) as watcher, \
+            PortalClient(stack.broker.interprocess_config(), name="nav_source") as client:
+        assert client.wait_subscribed()
+
+        def arrived() -> bool:
+            for msg in watcher.fetch():
+                value = msg.double() if msg.is_double() else msg.string()
+                if msg.key() != "GPS_UPDATE_RECEIVED" or value == f"Timestamp={stamp:.15g}":
+                    latest[msg.key()] = value
+            return latest.get("GPS_UPDATE_RECEIVED") == f"Timestamp={stamp:.15g}" and "NODE_REPORT" in latest \
+                and str(latest["NODE_REPORT"]).count(f"TIME={stamp:.15g}") == 1
+
+        deadline = time.monotonic() + TIMEOUT_S
+        while not arrived():  # republish until the translators' subscriptions are in place
+            assert time.monotonic() < deadline, f"no NAV_* arrived\n{stack.logs()}"
+            client.publish(groups.node_status, node_status(stamp))
+            client.poll(0.3)
+    assert latest["NAV_X"] == pytest.approx(REF_X, abs=0.005)
+    assert latest["NAV_Y"] == pytest.approx(REF_Y, abs=0.005)
+    assert latest["NAV_LAT"] == REF_LAT and latest["NAV_LONG"] == REF_LON
+    assert latest["NAV_DEPTH"] == 0.5
+    assert latest["NAV_HEADING"] == 120.0
+    assert latest["NAV_YAW"] == pytest.approx(-math.radians(120.0))
+    assert latest["NAV_SPEED"] == 1.25
+    assert latest["NAV_PITCH"] == pytest.approx(math.radians(2.0))
+    assert latest["NAV_ROLL"] == pytest.approx(math.radians(-3.0))
+    report = dict(item.split("=", 1) for item in str(latest["NODE_REPORT"]).split(","))
+    assert list(report) == ["NAME", "TYPE", "TIME", "X", "Y", "DEPTH", "HDG", "SPD"]
+    assert (report["NAME"], report["TYPE"], report["HDG"], report["SPD"], report["DEPTH"]) == (
+        "usv", "USV", "120", "1.25", "0.5")
+    assert float(report["X"]) == pytest.approx(REF_X, abs=0.005)
+    assert float(report["Y"]) == pytest.approx(REF_Y, abs=0.005)
+
+
+def test_desired_setpoints_become_desired_course_with_goby_fallback(stack):
+    with connected_comms(stack.moos_port, "fake_helm") as helm, \
+            PortalClient(stack.broker.interprocess_config(), name="interface") as client:
+        courses: list[DesiredCourse] = client.collect(groups.desired_course, DesiredCourse)
+        assert client.wait_subscribed()
+        # Readiness: DESIRED_SPEED alone until a course comes back (the gateway registered for it by then).
+        deadline = time.monotonic() + TIMEOUT_S
+        while not any(c.time == 100.0 for c in courses):
+            assert time.monotonic() < deadline, f"no desired_course arrived\n{stack.logs()}"
+            helm.notify("DESIRED_SPEED", 0.5, time=100.0)
+            client.poll_until(lambda: any(c.time == 100.0 for c in courses), 0.5)
+
+        helm.notify("DESIRED_HEADING", 270.0, time=200.0)
+        helm.notify("DESIRED_DEPTH", 12.0, time=200.0)
+        helm.notify("DESIRED_PITCH", 4.0, time=200.0)
+        helm.notify("DESIRED_ROLL", -2.0, time=200.0)
+        helm.notify("DESIRED_Z_RATE", 0.25, time=200.0)
+        helm.notify("DESIRED_ALTITUDE", 7.0, time=200.0)
+        helm.notify("DESIRED_SPEED", 1.5, time=201.5)
+        assert client.poll_until(lambda: any(c.time == 201.5 for c in courses), TIMEOUT_S), stack.logs()
+        helm.notify("DESIRED_SPEED", 1.75, time=202.5)  # nothing else posted since: only speed this time
+        assert client.poll_until(lambda: any(c.time == 202.5 for c in courses), TIMEOUT_S), stack.logs()
+    full = next(c for c in courses if c.time == 201.5)
+    assert (full.speed, full.heading, full.depth, full.pitch, full.roll, full.z_rate, full.altitude) == (
+        1.5, 270.0, 12.0, 4.0, -2.0, 0.25, 7.0)
+    bare = next(c for c in courses if c.time == 202.5)
+    assert bare.speed == 1.75
+    for name in ("heading", "depth", "pitch", "roll", "z_rate", "altitude"):
+        assert not bare.HasField(name), name
+    assert bare.altitude == 10.0  # the proto default a frontseat sees
+
+
+def test_ivphelm_state_becomes_helm_state(stack):
+    with connected_comms(stack.moos_port, "pHelmIvP") as helm, \
+            PortalClient(stack.broker.interprocess_config(), name="interface_helm") as client:
+        reports: list[HelmStateReport] = client.collect(groups.helm_state, HelmStateReport)
+        assert client.wait_subscribed()
+        deadline = time.monotonic() + TIMEOUT_S
+        while not reports:
+            assert time.monotonic() < deadline, f"no helm_state arrived\n{stack.logs()}"
+            helm.notify("IVPHELM_STATE", "STANDBY")
+            client.poll_until(lambda: bool(reports), 0.5)
+        for value in ("DRIVE", " park ", "DRIVE+", "drive", "MALCONFIG"):
+            helm.notify("IVPHELM_STATE", value)
+        expected = [HELM_DRIVE, HELM_PARK, HELM_NOT_RUNNING, HELM_DRIVE, HELM_NOT_RUNNING]
+        # MOOS keeps one client's order, so late readiness reports (STANDBY) can only come before ours.
+        assert client.poll_until(lambda: [r.state for r in reports][-5:] == expected, TIMEOUT_S), (
+            [r.state for r in reports], stack.logs())
+    assert all(r.state == HELM_NOT_RUNNING for r in reports[:-5])
