@@ -555,6 +555,7 @@ class comms:  # noqa: N801 - pymoos's class name
         log.info("%s: connected to %s:%d (community %r)", self._name, self._host, self._port, self._community)
         self._reregister()
         self._run_callback(self._on_connect, "on-connect")
+        self._reregistered = set()  # only on-connect's repeats of the automatic registrations are skipped
         try:
             if self._async:
                 self._read_async(conn)
