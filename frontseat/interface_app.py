@@ -73,6 +73,7 @@ class FrontSeatInterface(MultiThreadApplication):
             raise
         self._next_status: float | None = None
         self._last_failure = ""
+        self._last_helm_report: float | None = None
 
     @property
     def driver(self) -> FrontSeatDriver:
@@ -118,6 +119,7 @@ class FrontSeatInterface(MultiThreadApplication):
     # ----- subscriptions (main thread) -------------------------------------------------------------------
     def _on_helm_state(self, report: fs_pb.HelmStateReport) -> None:
         self._driver.set_helm_state(report.state)
+        self._last_helm_report = self._driver.now()
 
     def _on_command_request(self, command: fs_pb.CommandRequest) -> None:
         if self._driver.state() != fs_pb.INTERFACE_COMMAND:
@@ -154,6 +156,7 @@ class FrontSeatInterface(MultiThreadApplication):
 
     # ----- the tick ---------------------------------------------------------------------------------------
     def loop(self) -> None:
+        self._expire_helm_state()
         try:
             self._driver.do_work()
         except Exception as exc:
@@ -169,6 +172,17 @@ class FrontSeatInterface(MultiThreadApplication):
             self.quit(0)
             return
         self._publish_status_if_due(frontseat_cfg.status_period)
+
+    def _expire_helm_state(self) -> None:
+        """A helm that stopped reporting is a helm that is not running (Goby keeps the last report forever)."""
+        timeout = self.cfg().frontseat_cfg.helm_running_timeout
+        if (
+            self._last_helm_report is not None
+            and self._driver.helm_state() != fs_pb.HELM_NOT_RUNNING
+            and self._driver.now() > self._last_helm_report + timeout
+        ):
+            log.warning("no helm_state report for %.1f s; treating the helm as not running", timeout)
+            self._driver.set_helm_state(fs_pb.HELM_NOT_RUNNING)
 
     def _publish_status_if_due(self, period: float) -> None:
         now = self._driver.now()
