@@ -117,9 +117,10 @@ class UsvMission:
             cwd=USV_DIR,
             report=self.report,
         )
-        self.group.start()
+        # The MOOS client retries until the MOOSDB is up, so it sees the track from the first fix.
         self.moos = MoosRecorder(self.record, self.clock, self.settings)
         self.moos.start()
+        self.group.start()
         self.portal = PortalRecorder(self.record, self.clock, self.settings)
         self.portal.start()
 

@@ -1,0 +1,116 @@
+"""The whole USV mission end to end: real processes from launch/usv/usv.launch, commands from shore, the track.
+
+Runs with our moos-db and ivp-helm always, and with the real MOOSDB and pHelmIvP when both are on PATH
+(run the real one inside a private network namespace: the C++ MOOSDB listens on every address).
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from pathlib import Path
+
+import pytest
+
+from launch.config import free_tcp_port
+from launch.usv.analysis import (
+    bhv_waypoints,
+    command_effects,
+    helm_timeline,
+    interface_timeline,
+    loiter_phases,
+    waypoint_approach,
+)
+from launch.usv.mission import MissionResult, UsvMission
+from launch.usv.settings import UsvSettings
+from launch.usv.summary import summary_text
+
+WARP = 30
+DURATION_S = 1150.0
+SCHEDULE = "0:polygon:6:200,450:waypoints,700:polygon:8:400"
+
+REAL_MOOS = shutil.which("MOOSDB") is not None and shutil.which("pHelmIvP") is not None
+
+
+def run_mission(run_dir: Path, moosdb: str, helm: str) -> MissionResult:
+    socket_dir = Path(tempfile.mkdtemp(prefix="usvt-", dir="/tmp"))  # AF_UNIX paths must stay short
+    settings = UsvSettings(
+        run_dir=run_dir,
+        warp=WARP,
+        moos_port=free_tcp_port(),
+        sim_port=free_tcp_port(),
+        moosdb=moosdb,
+        helm=helm,
+        schedule=SCHEDULE,
+        socket_name=str(socket_dir / "goby_usv"),
+    )
+    lines: list[str] = []
+    mission = UsvMission(settings, report=lines.append)
+    failure = None
+    try:
+        mission.start()
+        mission.run(DURATION_S)
+    except Exception as exc:  # the result carries it; the assertions below report it with the summary
+        failure = f"{type(exc).__name__}: {exc}"
+    finally:
+        result = mission.stop(failure)
+        shutil.rmtree(socket_dir, ignore_errors=True)
+    return result
+
+
+@pytest.mark.parametrize(
+    ("moosdb", "helm"),
+    [
+        pytest.param("moos-db", "ivp-helm", id="ours"),
+        pytest.param(
+            "MOOSDB", "pHelmIvP", id="real-moos-ivp",
+            marks=[pytest.mark.interop,
+                   pytest.mark.skipif(not REAL_MOOS, reason="MOOSDB and pHelmIvP are not on PATH")],
+        ),
+    ],
+)
+def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm):
+    result = run_mission(tmp_path / "run", moosdb, helm)
+    record = result.record
+    waypoints = bhv_waypoints(UsvSettings().bhv_file)
+    report = summary_text(result, waypoints)
+    assert result.failure is None, report
+
+    # The interface reached COMMAND and the helm drove the vehicle.
+    assert "INTERFACE_COMMAND" in [state for _, state in interface_timeline(record)], report
+    assert "DRIVE" in [state for _, state in helm_timeline(record)], report
+    assert len(record.nav) > 200, report
+
+    # Three commands reached MOOS, in order, with the postings CommandTranslation makes.
+    effects = command_effects(record)
+    assert [e.state for e in effects] == ["POLYGON", "WAYPOINTS", "POLYGON"], report
+    first, waypoints_cmd, second = effects
+    assert [p.name for p in waypoints_cmd.posts] == ["DEPLOY_STATE"], report
+    assert second.polygon_before_state, report
+    assert "radius=400" in second.posts[0].value and "pts=8" in second.posts[0].value, report
+
+    # It converged on the hexagon of radius 200 before the waypoints command.
+    phases = loiter_phases(record)
+    assert len(phases) == 2, report
+    hexagon, octagon = phases
+    assert len(hexagon.ring.vertices) == 6 and abs(hexagon.ring.mean_radius - 200) < 10, report
+    assert hexagon.settled_at is not None and hexagon.settled_at < waypoints_cmd.t - 100, report
+    assert hexagon.mean_distance is not None and hexagon.mean_distance < 10.0, report
+
+    # After WAYPOINTS it turned toward the first waypoint and closed on it.
+    approach = waypoint_approach(record, waypoints)
+    assert approach is not None, report
+    assert approach.min_heading_error is not None and approach.min_heading_error < 20.0, report
+    assert approach.min_range < approach.start_range - 100.0, report
+
+    # After the second polygon command it moved out to the larger ring and stayed on it.
+    assert len(octagon.ring.vertices) == 8 and abs(octagon.ring.mean_radius - 400) < 20, report
+    assert octagon.start >= second.t - 1.0, report
+    assert octagon.final_center_distance is not None and octagon.final_center_distance > 300.0, report
+    assert octagon.settled_at is not None and octagon.mean_distance is not None, report
+    assert octagon.mean_distance < 15.0, report
+
+    # Every process stopped cleanly and no log holds an unexpected error.
+    assert len(result.outcomes) == 8, report
+    assert all(o.clean for o in result.outcomes), report
+    assert result.log_errors == [], report
