@@ -82,6 +82,8 @@ class InterProcessPortal:
         self._regex: list[_RegexSubscription] = []
         self._held: deque[bytes] = deque()
         self._identifiers: dict[tuple[str, int, str], str] = {}
+        self._groups: dict[GroupLike, str] = {}
+        self._types: dict[tuple[type, int | None], tuple[int, str, str]] = {}
         self._closed = False
         self.dropped = 0
         self.malformed = 0
@@ -99,6 +101,7 @@ class InterProcessPortal:
         self._monitor = self._sub.get_monitor_socket(zmq.EVENT_CONNECTED | zmq.EVENT_DISCONNECTED)
         self._ever_connected = False
         self._disconnected = False
+        self._requery_at: float | None = None  # TCP: when to ask the manager for (possibly new) ports
         self._pub.connect(self._pub_endpoint)
         self._sub.connect(self._sub_endpoint)
         self._primary = context.claim_primary()
@@ -117,16 +120,29 @@ class InterProcessPortal:
     def publish(self, group: GroupLike, msg: Any, *, scheme: int | None = None) -> None:
         """Serialize ``msg`` and send it to every subscriber of (group, type) in all processes, this one included."""
         self._check_open()
-        grp = as_group(group)
-        check_named(grp, "InterProcess")
-        sch = default_scheme(type(msg)) if scheme is None else int(scheme)
-        if sch == Scheme.DCCL:
-            sch = Scheme.PROTOBUF  # as Goby: DCCL travels as PROTOBUF on interprocess
-        tname = type_name(type(msg), sch)
-        payload = serialize(msg, sch)
-        group_text = str(grp)
-        self._publish_frame(group_text, sch, tname, payload)
-        self._ctx.interthread.deliver(group_text, type_key(type(msg)), msg, self._mailbox)
+        group_text = self._group_text(group)
+        sch, tname, key = self._type_info(type(msg), scheme)
+        self._publish_frame(group_text, sch, tname, serialize(msg, sch))
+        self._ctx.interthread.deliver(group_text, key, msg, self._mailbox)
+
+    def _group_text(self, group: GroupLike) -> str:
+        """The validated wire string of ``group`` (cached: publishing is the hot path)."""
+        text = self._groups.get(group)
+        if text is None:
+            grp = as_group(group)
+            check_named(grp, "InterProcess")
+            text = self._groups[group] = str(grp)
+        return text
+
+    def _type_info(self, msg_type: type, scheme: int | None) -> tuple[int, str, str]:
+        """(scheme, wire type name, interthread key) for a type; DCCL becomes PROTOBUF as in Goby."""
+        info = self._types.get((msg_type, scheme))
+        if info is None:
+            sch = default_scheme(msg_type) if scheme is None else int(scheme)
+            if sch == Scheme.DCCL:
+                sch = Scheme.PROTOBUF
+            info = self._types[(msg_type, scheme)] = (sch, type_name(msg_type, sch), type_key(msg_type))
+        return info
 
     def publish_serialized(self, group: GroupLike, scheme: int, type_name_: str, payload: bytes) -> None:
         """Send an already-encoded payload (gateways relaying data whose class is not imported)."""
@@ -152,7 +168,7 @@ class InterProcessPortal:
 
     def _send(self, frame: bytes) -> bool:
         try:
-            self._pub.send(frame, zmq.NOBLOCK, copy=len(frame) > 4096)
+            self._pub.send(frame, zmq.NOBLOCK)
             return True
         except zmq.Again:
             pass
@@ -187,27 +203,20 @@ class InterProcessPortal:
         ``echo=False`` drops this process's own publications (Goby delivers them: the default is ``True``).
         """
         self._check_open()
-        grp = as_group(group)
-        check_named(grp, "InterProcess")
-        sch = default_scheme(msg_type) if scheme is None else int(scheme)
-        if sch == Scheme.DCCL:
-            sch = Scheme.PROTOBUF
-        tname = type_name(msg_type, sch)
-        prefix = type_prefix(str(grp), sch, tname).encode()
-        self._record("subscribe", str(grp), sch, tname)
+        group_text = self._group_text(group)
+        sch, tname, _ = self._type_info(msg_type, scheme)
+        prefix = type_prefix(group_text, sch, tname).encode()
+        self._record("subscribe", group_text, sch, tname)
         if prefix not in self._subs:
             self._subs[prefix] = []
             self._sub.setsockopt(zmq.SUBSCRIBE, prefix)
-        self._subs[prefix].append(_Subscription(msg_type, sch, callback, echo, str(grp)))
+        self._subs[prefix].append(_Subscription(msg_type, sch, callback, echo, group_text))
 
     def unsubscribe(self, group: GroupLike, msg_type: type, *, scheme: int | None = None) -> None:
         """Remove this thread's subscriptions to (group, msg_type)."""
         self._check_open()
-        grp = as_group(group)
-        sch = default_scheme(msg_type) if scheme is None else int(scheme)
-        if sch == Scheme.DCCL:
-            sch = Scheme.PROTOBUF
-        prefix = type_prefix(str(grp), sch, type_name(msg_type, sch)).encode()
+        sch, tname, _ = self._type_info(msg_type, scheme)
+        prefix = type_prefix(self._group_text(group), sch, tname).encode()
         if self._subs.pop(prefix, None) is not None:
             self._sub.setsockopt(zmq.UNSUBSCRIBE, prefix)
 
@@ -280,13 +289,37 @@ class InterProcessPortal:
         if self._held and self._ctx.hold_released:
             self._flush_held()
             events += 1
+        if self._requery_at is not None and now >= self._requery_at:
+            self._requery_endpoints(now)
         return events
+
+    def _requery_endpoints(self, now: float) -> None:
+        """TCP after a broker restart: the pub/sub ports are ephemeral, so ask the manager where they are now."""
+        try:
+            pub, sub, _ = request_endpoints(self._ctx.zmq_context, self._cfg, self._ctx.client_name, timeout_s=0.3)
+        except Exception as exc:  # noqa: BLE001 - broker still down: try again later
+            log.debug("%s: manager not answering yet (%s)", self._thread_name, exc)
+            self._requery_at = now + 1.0
+            return
+        self._requery_at = None
+        if (pub, sub) == (self._pub_endpoint, self._sub_endpoint):
+            return
+        log.warning("%s: broker moved to publish %s / subscribe %s; reconnecting", self._thread_name, pub, sub)
+        for sock, old, new in ((self._pub, self._pub_endpoint, pub), (self._sub, self._sub_endpoint, sub)):
+            try:
+                sock.disconnect(old)
+            except zmq.ZMQError:
+                pass
+            sock.connect(new)
+        self._pub_endpoint, self._sub_endpoint = pub, sub
 
     def next_deadline(self) -> float | None:
         """The monotonic time ``service`` next needs to run, if any."""
+        deadline = self._requery_at
         if self._primary and not self._ctx.hold_released:
-            return self._release_at if self._release_at is not None else self._next_hold_request
-        return None
+            hold = self._release_at if self._release_at is not None else self._next_hold_request
+            deadline = hold if deadline is None else min(deadline, hold)
+        return deadline
 
     def _send_hold_request(self) -> None:
         request = ManagerRequest(
@@ -392,6 +425,8 @@ class InterProcessPortal:
             kind = event["event"]
             if kind == zmq.EVENT_DISCONNECTED:
                 self._disconnected = True
+                if self._cfg.transport == InterProcessPortalConfig.TCP:
+                    self._requery_at = time.monotonic() + 1.0
                 log.warning("%s: lost connection to the broker (%s); ZeroMQ will reconnect and resubscribe",
                             self._thread_name, self._sub_endpoint)
             elif kind == zmq.EVENT_CONNECTED:
@@ -400,6 +435,7 @@ class InterProcessPortal:
                                 self._thread_name, self._sub_endpoint, len(self._subs) + len(self._regex))
                 self._disconnected = False
                 self._ever_connected = True
+                self._requery_at = None
 
     # ---------------------------------------------------------------------------------------- misc
     def _record(self, direction: str, group: str, scheme: int, tname: str) -> None:
