@@ -127,6 +127,8 @@ class Helm:
         out: list[Post] = []
         if self.state in ("PARK", "DRIVE"):
             self.state = "DRIVE" if self.has_control else "PARK"
+        if self.state != self._posted_state:
+            log.info("IVPHELM_STATE %s -> %s", self._posted_state or "(start)", self.state)
         if self.state != "DISABLED" or self._posted_state != "DISABLED":
             out.append(Post("IVPHELM_STATE", self.state))
             self._posted_state = self.state
@@ -176,6 +178,7 @@ class Helm:
         if self.state not in ("PARK", "DRIVE") or message == self._allstop:
             return []
         out = [Post("IVPHELM_ALLSTOP", message)]
+        log.info("IVPHELM_ALLSTOP=%s", message)
         if message == "clear":
             self._allstop = message
             return out
