@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import socket
 import time
 
 import pytest
@@ -185,10 +186,11 @@ def test_bad_input_leaves_the_server_serving_other_clients() -> None:
                 "",
             )
             bad.send_bytes(b"X" * (1024 * 1024) + b"\r\n")  # a 1 MB line
-            bad.send_bytes(b"CMD,HEADING:1,SPE")  # then leave mid-line
-        # the three malformed CMDs are answered with errors, nothing else is answered, NAV keeps flowing
-        seen: list[str] = []
-        wait_until(lambda: seen.append(good.read_line()) or seen.count(protocol.CMD_ERROR) == 3, timeout=30)
+            bad.send_bytes(b"CMD,HEADING:1,SPE")  # then leave mid-line: FIN after the data, so none of it is lost
+            bad.sock.shutdown(socket.SHUT_WR)
+            # the three malformed CMDs are answered with errors, nothing else is answered, NAV keeps flowing
+            seen: list[str] = []
+            wait_until(lambda: seen.append(good.read_line()) or seen.count(protocol.CMD_ERROR) == 3, timeout=30)
         seen += [good.read_line() for _ in range(30)]
         assert seen.count(protocol.CMD_ERROR) == 3
         assert protocol.CTRL_PAYLOAD not in seen
