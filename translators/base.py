@@ -30,9 +30,10 @@ __all__ = ["LOOP_FREQUENCY_HZ", "TIME_VAR", "MOOSInterface", "Translator"]
 class Translator(SimpleThread):
     """Base class for translators: ``goby()`` is the portal side, ``moos()`` the MOOS side.
 
-    Construct it on the thread that runs it (``MultiThreadApplication.launch_thread`` does).  The constructor
-    connects the MOOS client to ``cfg.moos.server:cfg.moos.port`` as :meth:`translator_name`; triggers and
-    buffers added before or after the connection are (re-)registered on every connect.
+    Construct it on the thread that runs it (``MultiThreadApplication.launch_thread`` does).  ``run()`` connects
+    the MOOS client to ``cfg.moos.server:cfg.moos.port`` as :meth:`translator_name` (Goby connects in the
+    constructor; we wait until construction succeeded, so a failing subclass constructor leaves no client
+    behind).  Triggers and buffers added before or after the connection are (re-)registered on every connect.
 
     ``comms_kind`` picks the client (``"ours"``, ``"pymoos"``, ``"auto"``; default ``GOBY_MOOS_CLIENT`` or ours),
     see ``gateway.moos.make_comms``.
@@ -53,8 +54,6 @@ class Translator(SimpleThread):
             goby_time=clock.now,
             technique=cfg.moos.moos_parser_technique,
         )
-        comms.run(cfg.moos.server, cfg.moos.port, self._name)
-        log.info("%s: MOOS client started for %s:%d", self._name, cfg.moos.server, cfg.moos.port)
 
     def goby(self) -> Translator:
         """The Goby side: ``goby().interprocess()`` / ``goby().interthread()`` publish and subscribe.
@@ -70,6 +69,13 @@ class Translator(SimpleThread):
     def translator_name(self) -> str:
         """``goby::moos::Translator::<thread id>``: this translator's MOOS client name (unique per thread)."""
         return self._name
+
+    def run(self) -> None:
+        """Start the MOOS client, then the thread's loop (``initialize``, ``loop`` at 10 Hz x warp, ``finalize``)."""
+        cfg = self.cfg()
+        self._moos.start(cfg.moos.server, cfg.moos.port, self._name)
+        log.info("%s: MOOS client started for %s:%d", self._name, cfg.moos.server, cfg.moos.port)
+        super().run()
 
     def loop(self) -> None:
         """10 Hz x warp: posts ``GOBY_MOOS_TRANSLATOR_TIME`` about once a second and fetches leftover mail.

@@ -57,6 +57,7 @@ class MOOSInterface:
         self._wake_lock = threading.Lock()
         self._mail_pending = False
         self._closed = False
+        self._started = False
         self.mail_batches = 0  # how many fetch batches were handled (for tests and benchmarks)
         comms.set_on_connect_callback(self._on_connect_io)
         comms.set_on_mail_callback(self._on_mail_io)
@@ -182,12 +183,18 @@ class MOOSInterface:
         log.info("MOOS connected; registered %d trigger(s), %d buffer(s), %d wildcard(s)",
                  len(self._triggers), len(self._buffer_vars), len(self._wildcards))
 
+    def start(self, server: str, port: int, name: str) -> None:
+        """Connect the client (asynchronously; it reconnects by itself) as ``name``; on the owner thread."""
+        self._started = True
+        self._comms.run(server, port, name)
+
     def close(self) -> None:
         """Close the client (flushing queued notifies); idempotent."""
         if self._closed:
             return
         self._closed = True
-        self._comms.close(True)
+        if self._started:
+            self._comms.close(True)
 
     # ------------------------------------------------------------------------------ client I/O thread
     def _on_connect_io(self) -> bool:

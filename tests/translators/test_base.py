@@ -113,6 +113,25 @@ def test_both_directions_on_the_translator_thread(infrastructure, translator_cla
         assert seen == ["ok"]
 
 
+class FailingTranslator(Translator):
+    def __init__(self, cfg) -> None:
+        super().__init__(cfg)
+        self.moos().add_trigger("IN", print)
+        raise RuntimeError("bad translator config")
+
+
+def test_failing_constructor_leaves_nothing_running(infrastructure):
+    from gateway.moos_gateway import PluginLoadError
+
+    db, broker = infrastructure
+    cfg = gateway_config(db.port, broker.interprocess_config())
+    with pytest.raises(PluginLoadError, match="bad translator config"):
+        with hosted_translators(cfg, RecordingTranslator, FailingTranslator):
+            pass
+    # the RecordingTranslator launched before it was stopped again; the leak check of conftest.py verifies
+    # that no MOOS client or translator thread is left running
+
+
 def test_translator_time_variable(infrastructure):
     db, broker = infrastructure
     cfg = gateway_config(db.port, broker.interprocess_config())
