@@ -172,12 +172,18 @@ class InterProcessPortal:
             return True
         except zmq.Again:
             pass
-        if self._pub.poll(int(SEND_BLOCK_S * 1000), zmq.POLLOUT):
+        # The queue toward the broker is full.  POLLOUT on a PUB socket reports writable even then, so wait by
+        # retrying: this back-pressure is the broker not keeping up (slow subscribers never cause it).
+        deadline = time.monotonic() + SEND_BLOCK_S
+        pause = 0.0001
+        while time.monotonic() < deadline:
+            time.sleep(pause)
+            pause = min(pause * 2, 0.01)
             try:
                 self._pub.send(frame, zmq.NOBLOCK)
                 return True
             except zmq.Again:
-                pass
+                continue
         self.dropped += 1
         log.error(
             "%s: dropped a publication (%s): the send queue to the broker stayed full for %.1f s "
