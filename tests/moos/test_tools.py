@@ -1,0 +1,118 @@
+"""The console scripts: moos-db (flags and mission file), moos-poke and moos-scope."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from gateway.moos import poke, scope
+from gateway.moos.testing import MoosDBProcess, collect_mail, connected_comms, free_port, running_moosdb
+
+BIN = Path(sys.executable).parent
+
+
+def test_moos_db_reads_the_mission_file_and_flags_win(tmp_path: Path) -> None:
+    port = free_port()
+    mission = tmp_path / "m.moos"
+    mission.write_text(f"ServerPort = {port}\nCommunity = fromfile\nMOOSTimeWarp = 4\n")
+    db = MoosDBProcess(tmp_path, community="fromflag", warp=4.0, port=0)
+    db.extra_args = [str(mission)]
+    # the flags MoosDBProcess passes (--moos_port=0, --moos_community) override the file
+    with db:
+        assert db.port != port
+        with connected_comms(db.port, "probe") as probe:
+            assert probe.get_community_name() == "fromflag"
+
+
+def test_moos_db_console_script_uses_the_mission_file(tmp_path: Path) -> None:
+    port = free_port()
+    mission = tmp_path / "m.moos"
+    mission.write_text(f"ServerPort = {port}\nCommunity = fromfile\n")
+    proc = subprocess.Popen([str(BIN / "moos-db"), str(mission)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            cwd=tmp_path)
+    try:
+        line = proc.stdout.readline().decode()  # type: ignore[union-attr]
+        assert line.strip() == f"MOOSDB fromfile listening on 127.0.0.1:{port}"
+        with connected_comms(port, "probe") as probe:
+            assert probe.get_community_name() == "fromfile"
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=10)
+    assert proc.returncode == 0
+
+
+def test_moos_db_refuses_a_taken_port(tmp_path: Path) -> None:
+    with running_moosdb() as db:
+        run = subprocess.run([str(BIN / "moos-db"), f"--moos_port={db.port}"], capture_output=True, text=True,
+                             timeout=30, cwd=tmp_path)
+        assert run.returncode == 1
+        assert "cannot start the MOOSDB" in run.stderr
+
+
+def test_moos_db_accepts_the_cpp_options_it_ignores(tmp_path: Path) -> None:
+    run = subprocess.run([str(BIN / "moos-db"), "--moos_print_version", "-s", "--response=x:20", "--tcpnodelay"],
+                         capture_output=True, text=True, timeout=30, cwd=tmp_path)
+    assert run.returncode == 0 and "MOOS v10" in run.stdout
+
+
+def test_poke_sends_doubles_and_strings_and_confirms(capsys: pytest.CaptureFixture[str]) -> None:
+    with running_moosdb() as db, connected_comms(db.port, "watch", ["P_D", "P_S", "P_F"]) as watch:
+        assert poke.main(["P_D=3.5", "P_S=hello world", "P_F:=12", f"--port={db.port}", "--host=127.0.0.1"]) == 0
+        got = {m.key(): m for m in collect_mail(watch, ["P_D", "P_S", "P_F"])}
+        assert got["P_D"].is_double() and got["P_D"].double() == 3.5
+        assert got["P_S"].string() == "hello world" and got["P_F"].string() == "12"
+        assert got["P_D"].source() == "uPokeDB"
+        out = capsys.readouterr().out
+        assert out.count(" ok") == 3
+        # a write the DB refuses (type lock) is reported and fails the exit code
+        assert poke.main(["P_D=not a number", f"--port={db.port}"]) == 1
+        assert "NOT CONFIRMED" in capsys.readouterr().out
+
+
+def test_poke_reports_an_unreachable_db(capsys: pytest.CaptureFixture[str]) -> None:
+    assert poke.main(["X=1", f"--port={free_port()}", "--connect_timeout=0.5"]) == 1
+    assert "cannot connect" in capsys.readouterr().err
+
+
+def test_poke_parses_assignments() -> None:
+    assert poke.parse_assignment("A=1e3") == ("A", 1000.0)
+    assert poke.parse_assignment("A=nan") == ("A", "nan")
+    assert poke.parse_assignment("A:=1") == ("A", "1")
+    assert poke.parse_assignment("A=b=c") == ("A", "b=c")
+    with pytest.raises(ValueError):
+        poke.parse_assignment("novalue")
+
+
+def test_scope_once_prints_the_table(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    with running_moosdb() as db, connected_comms(db.port, "pNav") as nav:
+        nav.notify("NAV_X", 12.5)
+        nav.notify("NAV_NAME", "alpha")
+        mission = tmp_path / "s.moos"
+        mission.write_text(f"ServerHost = 127.0.0.1\nServerPort = {db.port}\n")
+        assert scope.main([str(mission), "NAV_X", "NAV_NAME", "--once"]) == 0
+        out = capsys.readouterr().out
+        rows = {line.split()[0]: line for line in out.splitlines()[2:]}
+        assert "pNav" in rows["NAV_X"] and rows["NAV_X"].rstrip().endswith("12.5")
+        assert rows["NAV_NAME"].rstrip().endswith('"alpha"') and "moos" in rows["NAV_NAME"]
+        assert scope.main(["NAV_X", "NEVER_WRITTEN", "--once", "--timeout=0.5", f"--port={db.port}"]) == 2
+        assert "n/a" in capsys.readouterr().out
+
+
+def test_scope_all_for_a_duration(capsys: pytest.CaptureFixture[str]) -> None:
+    with running_moosdb() as db, connected_comms(db.port, "pub") as pub:
+        pub.notify("ANY_ONE", 1.0)
+        assert scope.main(["--all", "--duration=0.6", "--refresh=0.2", f"--port={db.port}"]) == 0
+        assert "ANY_ONE" in capsys.readouterr().out
+
+
+def test_console_scripts_run(tmp_path: Path) -> None:
+    with running_moosdb() as db:
+        run = subprocess.run([str(BIN / "moos-poke"), "CS_X=2", f"--port={db.port}"], capture_output=True,
+                             text=True, timeout=30)
+        assert run.returncode == 0, run.stderr
+        run = subprocess.run([str(BIN / "moos-scope"), "CS_X", "--once", f"--port={db.port}"], capture_output=True,
+                             text=True, timeout=30)
+        assert run.returncode == 0 and "uPokeDB" in run.stdout
