@@ -11,6 +11,7 @@ import logging
 
 from google.protobuf import text_format
 
+from gateway.portal import MultiThreadApplication
 from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from translators.base import Translator
 from translators.usv import groups
@@ -78,11 +79,11 @@ class CommandTranslation(Translator):
         self.goby().interprocess().publish(groups.usv_command_ack, ack)
 
 
-def load(gateway) -> None:  # noqa: ANN001 - the gateway application (gateway.plugins calls this)
-    """Plugin entry: start the translator thread in the gateway."""
+def load(gateway: MultiThreadApplication) -> None:
+    """Plugin entry: launch the translator thread. Runs on the gateway's main thread."""
     gateway.launch_thread(CommandTranslation)
 
 
-def unload(gateway) -> None:  # noqa: ANN001
-    """Plugin exit: join the translator thread."""
+def unload(gateway: MultiThreadApplication) -> None:
+    """Plugin exit: join the translator thread. Runs on the gateway's main thread."""
     gateway.join_thread(CommandTranslation)

@@ -16,6 +16,7 @@ from frontseat.protobuf.frontseat_pb2 import HelmState, HelmStateReport
 from frontseat.protobuf.navigation_pb2 import DatumUpdate
 from gateway.geodesy import UTMGeodesy
 from gateway.moos import MoosMessage
+from gateway.portal import MultiThreadApplication
 from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from translators.base import Translator
 from translators.helm_conversion import (
@@ -89,11 +90,11 @@ class FrontSeatTranslation(Translator):
         log.debug("IVPHELM_STATE %r -> helm_state %s", msg.string(), HelmState.Name(report.state))
 
 
-def load(gateway) -> None:  # noqa: ANN001 - the gateway application (gateway.plugins calls this)
-    """Plugin entry: start the translator thread in the gateway (as Goby's ``goby3_moos_gateway_load``)."""
+def load(gateway: MultiThreadApplication) -> None:
+    """Plugin entry (as Goby's ``goby3_moos_gateway_load``): launch the translator. Runs on the gateway's main thread."""
     gateway.launch_thread(FrontSeatTranslation)
 
 
-def unload(gateway) -> None:  # noqa: ANN001
-    """Plugin exit: join the translator thread (as Goby's ``goby3_moos_gateway_unload``)."""
+def unload(gateway: MultiThreadApplication) -> None:
+    """Plugin exit: join the translator thread. Runs on the gateway's main thread."""
     gateway.join_thread(FrontSeatTranslation)

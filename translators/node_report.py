@@ -12,6 +12,7 @@ import logging
 
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
+from gateway.portal import MultiThreadApplication
 from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from translators.base import Translator
 from translators.frontseat_translation import geodesy_from_config
@@ -37,11 +38,11 @@ class NodeReportTranslation(Translator):
         self.moos().comms().notify(NODE_REPORT, report)
 
 
-def load(gateway) -> None:  # noqa: ANN001 - the gateway application (gateway.plugins calls this)
-    """Plugin entry: start the translator thread in the gateway."""
+def load(gateway: MultiThreadApplication) -> None:
+    """Plugin entry: launch the translator thread. Runs on the gateway's main thread."""
     gateway.launch_thread(NodeReportTranslation)
 
 
-def unload(gateway) -> None:  # noqa: ANN001
-    """Plugin exit: join the translator thread."""
+def unload(gateway: MultiThreadApplication) -> None:
+    """Plugin exit: join the translator thread. Runs on the gateway's main thread."""
     gateway.join_thread(NodeReportTranslation)

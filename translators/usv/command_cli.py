@@ -107,14 +107,14 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser()
     args, goby_argv = parser.parse_known_args(argv)
-    command = build_command(args, clock.now())
     try:
-        command = check_dccl_bounds(command)
+        command = check_dccl_bounds(build_command(args, 0.0))
     except DcclBoundsError as error:
         print(f"{PROG}: refused, nothing sent: {error}", file=sys.stderr)
         return EXIT_REFUSED
 
     def make_app(cfg: CommandTool) -> CommandSender:
+        command.time = clock.now()  # stamped here: run_application has applied app.simulation (warp) by now
         timeout = args.timeout if args.timeout is not None else cfg.ack_timeout
         return CommandSender(cfg, command, timeout)
 
