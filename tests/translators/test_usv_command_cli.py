@@ -75,3 +75,11 @@ def test_bad_goby_option_is_a_configuration_error(tmp_path):
     result = run_cli(["waypoints", "--interprocess", "no_such_field: 1"], {}, tmp_path)
     assert result.returncode == 2
     assert "no_such_field" in result.stderr
+
+
+def test_example_config_needs_no_command(capsys):
+    from translators.usv.command_cli import main
+
+    assert main(["--example_config"]) == 0
+    out = capsys.readouterr().out
+    assert "ack_timeout: 10" in out and "interprocess {" in out

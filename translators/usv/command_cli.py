@@ -105,6 +105,8 @@ class CommandSender(SingleThreadApplication):
 def main(argv: list[str] | None = None) -> int:
     """Console script ``usv-command``."""
     argv = sys.argv[1:] if argv is None else list(argv)
+    if {"-e", "--example_config"} & set(argv):  # the Goby option works without a command
+        return run_application(lambda cfg: None, CommandTool, ["--example_config"], prog=PROG)
     parser = build_parser()
     args, goby_argv = parser.parse_known_args(argv)
     try:
