@@ -15,7 +15,6 @@ import shutil
 import signal
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 
@@ -107,16 +106,14 @@ def run_demo(args: argparse.Namespace) -> int:
     duration = args.duration if args.duration > 0 else None
     print(f"USV mission: {settings.moosdb}, {settings.helm}, warp {settings.warp}, MOOS port {settings.moos_port}, "
           f"simulator port {settings.sim_port}; logs in {settings.log_dir}", flush=True)
-    stop = threading.Event()
-    previous = {s: signal.signal(s, lambda *_: stop.set()) for s in (signal.SIGINT, signal.SIGTERM)}
     mission = UsvMission(settings)
+    previous = {s: signal.signal(s, lambda *_: mission.stop_event.set()) for s in (signal.SIGINT, signal.SIGTERM)}
     failure = None
     started = time.monotonic()
     try:
         mission.start()
         print("waiting for the frontseat interface to reach COMMAND ...", flush=True)
-        mission.run(duration, lambda t: print(progress_line(mission.record, t, duration), flush=True),
-                    should_stop=stop.is_set)
+        mission.run(duration, lambda t: print(progress_line(mission.record, t, duration), flush=True))
     except LaunchError as exc:
         failure = str(exc)
         print(f"demo: {exc}", file=sys.stderr, flush=True)

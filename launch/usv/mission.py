@@ -9,6 +9,7 @@ from __future__ import annotations
 import logging
 import re
 import shutil
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -101,6 +102,8 @@ class UsvMission:
         self.moos: MoosRecorder | None = None
         self.portal: PortalRecorder | None = None
         self.command_time: float | None = None
+        # Set from any thread or a signal handler to end start-up, the wait for COMMAND, or the run.
+        self.stop_event = threading.Event()
         self._stopped_result: MissionResult | None = None
 
     def start(self) -> None:
@@ -117,6 +120,7 @@ class UsvMission:
             cwd=USV_DIR,
             report=self.report,
         )
+        self.group.stop_event = self.stop_event
         # The MOOS client retries until the MOOSDB is up, so it sees the track from the first fix.
         self.moos = MoosRecorder(self.record, self.clock, self.settings)
         self.moos.start()
@@ -142,10 +146,15 @@ class UsvMission:
             command = next((e.t for e in states if e.value == "INTERFACE_COMMAND"), None)
             self.command_time = command
 
-    def wait_for_command(self, timeout_s: float = 120.0) -> float:
-        """Block until the frontseat interface reports INTERFACE_COMMAND; returns that sim time."""
+    def wait_for_command(self, timeout_s: float = 120.0) -> float | None:
+        """Block until the frontseat interface reports INTERFACE_COMMAND; returns that sim time.
+
+        Returns None if ``stop_event`` is set first.
+        """
         deadline = time.monotonic() + timeout_s
         while self.command_time is None:
+            if self.stop_event.is_set():
+                return None
             self.poll()
             if time.monotonic() > deadline:
                 seen = [e.value for e in self.record.events_named("interface_state")]
@@ -161,12 +170,13 @@ class UsvMission:
         duration_s: float | None,
         progress: Callable[[float], None] | None = None,
         progress_period_s: float = 2.0,
-        should_stop: Callable[[], bool] = lambda: False,
     ) -> None:
-        """Run for ``duration_s`` sim seconds after COMMAND (None: until ``should_stop()``)."""
+        """Run for ``duration_s`` sim seconds after COMMAND (None: until ``stop_event`` is set)."""
         t0 = self.wait_for_command()
+        if t0 is None:
+            return
         next_progress = 0.0
-        while not should_stop():
+        while not self.stop_event.is_set():
             self.poll()
             elapsed = self.clock.now() - t0
             if progress is not None and time.monotonic() >= next_progress:

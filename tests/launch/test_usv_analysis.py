@@ -1,0 +1,106 @@
+"""Judging a mission from a hand-made record: polygons, command grouping, loiter phases, the waypoint turn."""
+
+from __future__ import annotations
+
+import csv
+import math
+
+import pytest
+
+from launch.usv.analysis import bhv_waypoints, command_effects, loiter_phases, waypoint_approach
+from launch.usv.geometry import parse_points, parse_polygon, radial_polygon
+from launch.usv.plot import write_track_png
+from launch.usv.record import MissionRecord, shifted
+from launch.usv.settings import UsvSettings
+
+
+def test_radial_polygon_matches_moos_ivp_vertex_order():
+    ring = radial_polygon(0, 0, 200, 6)
+    expected = [(100, 173.2), (200, 0), (100, -173.2), (-100, -173.2), (-200, 0), (-100, 173.2)]
+    for (x, y), (ex, ey) in zip(ring.vertices, expected, strict=True):
+        assert x == pytest.approx(ex, abs=0.1) and y == pytest.approx(ey, abs=0.1)
+    assert ring.center == pytest.approx((0, 0), abs=1e-9)
+    assert ring.distance((0, 0)) == pytest.approx(173.2, abs=0.1)  # the apothem
+    assert ring.distance((200, 0)) == pytest.approx(0, abs=1e-9)
+
+
+def test_polygon_strings():
+    assert len(parse_polygon("polygon=radial::x=0,y=0,radius=400,pts=8").vertices) == 8
+    assert len(parse_polygon("radial:: x=10, y=5, radius=50, pts=5").vertices) == 5
+    view = parse_polygon("pts={0,0:100,0:100,100:0,100},label=usv_polygon,edge_color=white")
+    assert view.label == "usv_polygon" and view.center == (50, 50)
+    assert parse_polygon("pts={0,0:100,0:100,100},active=false") is None
+    assert parse_polygon("radial::x=0,y=0,radius=0,pts=6") is None
+    assert parse_polygon("nonsense") is None
+    assert parse_points("pts={1,2:3,4},label=x") == [(1, 2), (3, 4)]
+
+
+def test_waypoints_are_read_from_the_usv_behaviour_file():
+    points = bhv_waypoints(UsvSettings().bhv_file)
+    assert points[0] == (134, 33) and len(points) > 50
+
+
+def _circle(record: MissionRecord, t0: float, t1: float, cx: float, cy: float, r: float) -> None:
+    for t in range(int(t0), int(t1)):
+        a = t / 50.0
+        record.add_nav(t, "NAV_X", cx + r * math.sin(a))
+        record.add_nav(t, "NAV_Y", cy + r * math.cos(a))
+        record.add_nav(t, "NAV_HEADING", 90.0)
+
+
+def _mission_record() -> MissionRecord:
+    record = MissionRecord()
+    record.add_event(0, "moos", "DEPLOY_STATE", "POLYGON", "pHelmIvP")  # the helm's initialize: not a command
+    _circle(record, 0, 100, 0, 0, 190)
+    record.add_event(100, "moos", "POLYGON_UPDATES", "polygon=radial::x=0,y=0,radius=200,pts=6", "gw")
+    record.add_event(100, "moos", "DEPLOY_STATE", "POLYGON", "gw")
+    _circle(record, 100, 300, 0, 0, 190)
+    record.add_event(300, "moos", "DEPLOY_STATE", "WAYPOINTS", "gw")
+    for i, t in enumerate(range(300, 400)):  # head straight for (134, 33) from (0, 190)
+        frac = i / 100
+        record.add_nav(t, "NAV_X", 134 * frac)
+        record.add_nav(t, "NAV_Y", 190 + (33 - 190) * frac)
+        record.add_nav(t, "NAV_HEADING", math.degrees(math.atan2(134, 33 - 190)) % 360)
+    record.add_event(400, "moos", "POLYGON_UPDATES", "polygon=radial::x=0,y=0,radius=400,pts=8", "gw")
+    record.add_event(400, "moos", "DEPLOY_STATE", "POLYGON", "gw")
+    record.add_nav(400, "NAV_X", 134)
+    record.add_nav(400, "NAV_Y", 33)
+    _circle(record, 401, 600, 134, 33, 380)
+    return record
+
+
+def test_commands_are_grouped_and_helm_initialisation_is_not_a_command():
+    effects = command_effects(_mission_record())
+    assert [e.state for e in effects] == ["POLYGON", "WAYPOINTS", "POLYGON"]
+    assert effects[0].polygon_before_state and effects[2].polygon_before_state
+    assert not effects[1].polygon_before_state
+    assert effects[2].t == 400
+
+
+def test_loiter_phases_use_the_commanded_ring_recentred_on_activation():
+    first, second = loiter_phases(_mission_record())
+    assert (first.start, first.end) == (0, 300)
+    assert first.ring.mean_radius == pytest.approx(200, abs=1)
+    assert first.mean_distance is not None and first.mean_distance < 15
+    assert second.start == 400
+    assert len(second.ring.vertices) == 8
+    assert second.ring.center == pytest.approx((134, 33), abs=1)  # where the vehicle was at t=400
+    assert second.final_center_distance == pytest.approx(380, abs=1)
+
+
+def test_waypoint_approach_measures_the_turn_and_the_closing_range():
+    approach = waypoint_approach(_mission_record(), [(134, 33)])
+    assert approach.waypoint == (134, 33)
+    assert approach.min_heading_error < 1
+    assert approach.min_range < approach.start_range - 100
+
+
+def test_outputs_csv_and_png(tmp_path):
+    record = shifted(_mission_record(), 100)
+    record.write_csv(tmp_path / "track.csv", tmp_path / "events.csv")
+    rows = list(csv.DictReader(open(tmp_path / "track.csv")))
+    assert rows[0]["t"] == "-100.00" and rows[-1]["deploy_state"] == "POLYGON"
+    assert any(r["deploy_state"] == "WAYPOINTS" for r in rows)
+    write_track_png(tmp_path / "track.png", record.nav, [(e.t, e.value) for e in record.events], loiter_phases(record),
+                    [(134, 33)], command_effects(record), "test")
+    assert (tmp_path / "track.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

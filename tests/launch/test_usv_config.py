@@ -1,0 +1,119 @@
+"""Config generation: every generated config parses into its real config message, and all agree."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+from google.protobuf import text_format
+
+import frontseat.protobuf.basic_simulator_config_pb2 as basic_sim_pb
+import frontseat.protobuf.moos_helm_frontseat_interface_config_pb2 as moos_helm_pb
+from frontseat.protobuf.frontseat_interface_config_pb2 import FrontSeatInterfaceConfig
+from gateway.moos.mission_file import MissionFile
+from gateway.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
+from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from launch.errors import ConfigError
+from launch.launchfile import parse_file
+from launch.usv.config import GENERATORS, generate, write_moos_file
+from launch.usv.mission import LAUNCH_FILE, choose_program
+from launch.usv.settings import UsvSettings
+from launch.usv.shore import parse_schedule
+from translators.usv.protobuf.usv_config_pb2 import CommandTool, USVManager
+
+PB_APPS = {
+    "broker": GobyDaemonConfig,
+    "frontseat_interface": FrontSeatInterfaceConfig,
+    "moos_gateway": GobyMOOSGatewayConfig,
+    "usv_manager": USVManager,
+    "shore": CommandTool,
+}
+
+
+@pytest.fixture
+def settings(tmp_path):
+    return UsvSettings(run_dir=tmp_path, warp=17, lat_origin=41.5, lon_origin=-70.7, moos_port=9123,
+                       sim_port=55123, socket_name=str(tmp_path / "goby_usv"))
+
+
+def test_every_goby_config_parses_and_agrees_on_warp_origin_and_broker(settings):
+    for app, config_type in PB_APPS.items():
+        cfg = text_format.Parse(generate(app, settings), config_type())
+        assert cfg.app.simulation.time.use_sim_time, app
+        assert cfg.app.simulation.time.warp_factor == 17, app
+        assert (cfg.app.geodesy.lat_origin, cfg.app.geodesy.lon_origin) == (41.5, -70.7), app
+        assert cfg.interprocess.platform == "usv", app
+        assert cfg.interprocess.socket_name == settings.ipc_base, app
+
+
+def test_frontseat_and_gateway_point_at_the_same_moosdb_and_simulator(settings):
+    fs = text_format.Parse(generate("frontseat_interface", settings), FrontSeatInterfaceConfig())
+    helm = fs.Extensions[moos_helm_pb.moos_helm]
+    sim = fs.frontseat_cfg.Extensions[basic_sim_pb.basic_simulator_config]
+    gw = text_format.Parse(generate("moos_gateway", settings), GobyMOOSGatewayConfig())
+    assert helm.port == gw.moos.port == 9123
+    assert sim.tcp_port == int(generate("frontseat_sim", settings)) == 55123
+    assert (sim.start.lat, sim.start.lon) == (41.5, -70.7)
+    assert fs.frontseat_cfg.sim_warp_factor == 17
+
+
+def test_moos_file_matches_the_goby_side(settings):
+    mission = MissionFile(write_moos_file(settings))
+    assert mission.server_port == 9123
+    assert mission.time_warp == 17
+    assert (float(mission.lat_origin), float(mission.long_origin)) == (41.5, -70.7)
+    helm = dict((k.lower(), v) for k, v in mission.process_config("pHelmIvP"))
+    assert helm["behaviors"] == str(settings.bhv_file)
+
+
+def test_settings_round_trip_through_the_environment(settings):
+    assert UsvSettings.from_env(settings.to_env()) == settings
+    with pytest.raises(ConfigError, match="USV_WARP='fast' is not a valid int"):
+        UsvSettings.from_env({"USV_WARP": "fast"})
+    with pytest.raises(ConfigError, match="warp must be"):
+        UsvSettings(warp=0)
+
+
+def test_the_config_script_prints_configs_and_fails_loudly(settings):
+    env = settings.to_env()
+    ok = subprocess.run([sys.executable, "-m", "launch.usv.config", "moos_gateway"], capture_output=True, text=True,
+                        env={**env, "PATH": "/usr/bin:/bin"}, timeout=60)
+    assert ok.returncode == 0 and "port: 9123" in ok.stdout
+    bad = subprocess.run([sys.executable, "-m", "launch.usv.config", "nope"], capture_output=True, text=True,
+                         env=env, timeout=60)
+    assert bad.returncode == 1
+    assert "INVALID CONFIGURATION" in bad.stdout  # what a process-substituted app would read
+    assert "App: nope not defined" in bad.stderr
+    assert set(GENERATORS) >= {"broker", "moos", "frontseat_sim"}
+
+
+def test_launch_file_has_every_component_in_order():
+    entries = parse_file(LAUNCH_FILE).entries
+    commands = " | ".join(e.command for e in entries)
+    for piece in ("frontseat-sim", "goby-broker", "USV_MOOSDB", "USV_HELM", "frontseat-interface", "moos-gateway",
+                  "usv-manager", "launch.usv.shore"):
+        assert piece in commands
+    env = {k: v for e in entries for k, v in e.env}
+    assert env["FRONTSEAT_DRIVER_LIBRARY"] == "basic_simulator"
+    assert env["GOBY_MOOS_GATEWAY_PLUGINS"] == "translators.command_translation"
+
+
+def test_schedule_parsing():
+    plan = parse_schedule("500:waypoints, 0:polygon:6:200,800:POLYGON:8:400")
+    assert [(c.at, c.args) for c in plan] == [
+        (0.0, ("polygon", "--sides", "6", "--radius", "200")),
+        (500.0, ("waypoints",)),
+        (800.0, ("polygon", "--sides", "8", "--radius", "400")),
+    ]
+    for bad in ("x:waypoints", "10:polygon:6", "10:circle", "-5:waypoints"):
+        with pytest.raises(ConfigError, match="bad schedule entry"):
+            parse_schedule(bad)
+
+
+def test_choosing_real_or_our_programs(monkeypatch):
+    monkeypatch.setenv("PATH", "/nonexistent")
+    assert choose_program("auto", "MOOSDB", "moos-db") == "moos-db"
+    assert choose_program("ours", "MOOSDB", "moos-db") == "moos-db"
+    with pytest.raises(ConfigError, match="MOOSDB was asked for but is not on PATH"):
+        choose_program("real", "MOOSDB", "moos-db")

@@ -1,0 +1,121 @@
+"""The user's entry points on the real USV launch file: goby-launch, and the demo until Ctrl-C."""
+
+from __future__ import annotations
+
+import csv
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+from launch.config import free_tcp_port
+from launch.launcher import child_environment
+from launch.usv.mission import LAUNCH_FILE
+from launch.usv.settings import UsvSettings
+
+
+class OutputReader:
+    """Collects a child's stdout on a thread (joined by ``finish``)."""
+
+    def __init__(self, proc: subprocess.Popen[str]) -> None:
+        self.proc = proc
+        self.lines: list[str] = []
+        self.thread = threading.Thread(target=lambda: self.lines.extend(proc.stdout), name="cli-output", daemon=True)
+        self.thread.start()
+
+    @property
+    def text(self) -> str:
+        return "".join(self.lines)
+
+    def wait_for(self, pattern: str, timeout: float = 90.0) -> re.Match[str]:
+        deadline = time.monotonic() + timeout
+        while True:
+            match = re.search(pattern, self.text, flags=re.M)
+            if match:
+                return match
+            if self.proc.poll() is not None or time.monotonic() > deadline:
+                raise AssertionError(f"never saw {pattern!r}; output so far:\n{self.text}")
+            time.sleep(0.1)
+
+    def finish(self, timeout: float = 90.0) -> str:
+        try:
+            self.proc.wait(timeout=timeout)
+        finally:
+            if self.proc.poll() is None:
+                self.proc.kill()
+                self.proc.wait()
+            self.thread.join(timeout=10)
+        return self.text
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_path):
+    socket_dir = Path(tempfile.mkdtemp(prefix="usvl-", dir="/tmp"))
+    settings = UsvSettings(run_dir=tmp_path / "run", warp=10, moos_port=free_tcp_port(), sim_port=free_tcp_port(),
+                           moosdb="moos-db", helm="ivp-helm", socket_name=str(socket_dir / "goby_usv"))
+    env = child_environment() | settings.to_env()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "launch.launcher", "-d", "200", "--status-period", "1", "-L", str(tmp_path / "logs"),
+         str(LAUNCH_FILE)],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env,
+    )
+    out = OutputReader(proc)
+    try:
+        out.wait_for(r"All processes running \(8\)")
+        helm_pid = int(out.wait_for(r"^Launched \((\d+)\) usv\.helm:").group(1))
+        os.kill(helm_pid, signal.SIGKILL)
+        text = out.finish()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        out.finish()
+        shutil.rmtree(socket_dir, ignore_errors=True)
+    assert proc.returncode == 1, text
+    assert "usv.helm died unexpectedly (exit status -9)" in text
+    pids = [int(p) for p in re.findall(r"^Launched \((\d+)\)", text, flags=re.M)]
+    assert len(pids) == 8
+    assert not any(_alive(pid) for pid in pids), text
+    logs = sorted(p.name for p in (tmp_path / "logs").iterdir())
+    assert "usv.frontseat-interface.log" in logs and "usv.shore.log" in logs
+    assert "MOOSDB usv listening" in (tmp_path / "logs" / "usv.moosdb.log").read_text()
+
+
+def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(tmp_path):
+    out_dir = tmp_path / "o"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--duration", "0", "--warp", "20",
+         "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_tcp_port()),
+         "--sim-port", str(free_tcp_port())],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+    out = OutputReader(proc)
+    try:
+        out.wait_for(r"^t=\s*(1\d\d|[2-9]\d\d) s sim \| interface INTERFACE_COMMAND \| helm DRIVE")
+        proc.send_signal(signal.SIGINT)
+        text = out.finish()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        out.finish()
+    assert proc.returncode == 0, text
+    assert "=== USV mission summary" in text
+    assert "processes: 8/8 exited cleanly" in text
+    assert "1. t=" in text and "POLYGON_UPDATES=polygon=radial::x=0,y=0,radius=200,pts=6" in text
+    rows = list(csv.DictReader(open(out_dir / "track.csv")))
+    assert len(rows) > 50
+    assert max(float(r["x"]) ** 2 + float(r["y"]) ** 2 for r in rows) > 100**2  # it moved out toward the ring
+    assert (out_dir / "track.png").stat().st_size > 10_000
+    assert (out_dir / "events.csv").exists()
