@@ -1,0 +1,124 @@
+"""Smaller helm semantics: flag timing, waypoint order/repeat, DISABLED, skew, deferred initialize, alias."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from behaviors.helm.app import HelmApp
+from gateway.moos import MoosClock
+from gateway.moos.testing import running_moosdb
+
+from .core_loop import CoreLoop, make_helm
+from .kinematic_vehicle import KinematicModel
+from .moos_harness import WARP, observer, write_mission
+
+FLAGS = """\
+initialize GO = false
+initialize_ LATE = 7
+Behavior = BHV_ConstantHeading
+{
+  name = hdg
+  condition = GO = true
+  heading = 90
+  duration = no-time-limit
+  runflag = RUN = $[BHVNAME]
+  activeflag = ACT = 1
+  inactiveflag = INACT = $[CTR]
+  idleflag = IDLE = yes
+  updates = HDG_UPDATES
+}
+Behavior = BHV_ConstantSpeed
+{
+  name = watcher
+  condition = ACT = 1
+  speed = 1
+  duration = no-time-limit
+  runflag = SAW_ACT = true
+}
+"""
+
+
+def test_flag_timing_and_visibility_on_the_next_iteration(tmp_path: Path) -> None:
+    loop = CoreLoop(make_helm(tmp_path, FLAGS, start_engaged="true"))
+    loop.run(2)
+    assert loop.values("IDLE") == ["yes"] and len(loop.values("INACT")) == 1
+    assert loop.values("LATE") == [7.0]  # deferred: posted once the helm saw its own IVPHELM_STATE
+    loop.poke("GO", "true")
+    loop.run(0.1)  # one iteration
+    assert loop.values("RUN") == ["hdg"] and loop.values("ACT") == [1.0]
+    assert loop.values("SAW_ACT") == []  # flags enter the info buffer after every behaviour has run
+    loop.run(0.1)
+    assert loop.values("SAW_ACT") == ["true"]
+    loop.run(2)
+    assert loop.values("RUN") == ["hdg"] and loop.values("ACT") == [1.0]  # on transitions only
+    loop.poke("HDG_UPDATES", "heading=180 # pwt=50")
+    loop.run(1)
+    assert loop.last("DESIRED_HEADING") == 180.0
+    assert loop.values("IVPHELM_UPDATE_RESULT")[-1].startswith("bhv=hdg,var=HDG_UPDATES,")
+    loop.poke("HDG_UPDATES", "heading=180 # pwt=50")
+    loop.run(0.5)
+    assert "result=duplicate" in loop.values("IVPHELM_UPDATE_RESULT")[-1]
+    loop.poke("HDG_UPDATES", "name=other # heading=0")
+    loop.run(0.5)
+    assert "result=name_mismatch" in loop.values("IVPHELM_UPDATE_RESULT")[-1]
+    loop.poke("GO", "false")
+    loop.run(1)
+    assert loop.values("IDLE") == ["yes", "yes"] and len(loop.values("INACT")) == 2
+
+
+REPEAT = """\
+Behavior = BHV_Waypoint
+{
+  name = w
+  speed = 2
+  capture_radius = 4
+  slip_radius = 0
+  order = reverse
+  repeat = 1
+  wptflag = HIT = $(PX),$(PY)
+  cycleflag = CYCLED = $[CYCLES]
+  endflag = END = true
+  points = 0,30:30,30
+}
+"""
+
+
+def test_reverse_order_and_one_repeat(tmp_path: Path) -> None:
+    loop = CoreLoop(make_helm(tmp_path, REPEAT, start_engaged="true"))
+    assert loop.run(400, until=lambda: loop.values("END"))
+    assert loop.values("HIT") == ["30,30", "0,30", "30,30", "0,30"]
+    assert loop.values("CYCLED") == [1.0, 2.0]
+    assert loop.values("WPT_STAT").count("behavior-name=w,cycled") == 1
+    assert loop.last("WPT_STAT") == "behavior-name=w,completed"
+    assert loop.helm.engine.behaviors[0].name == "w"  # repeat > 0 made it perpetual: it stays
+
+
+def test_another_helm_state_disables_this_helm(tmp_path: Path) -> None:
+    loop = CoreLoop(make_helm(tmp_path, REPEAT, start_engaged="true"))
+    loop.run(2)
+    loop._deliver(loop.helm.handle_mail("IVPHELM_STATE", "DRIVE", loop.t, "pHelmIvP_other", loop.t))
+    loop.run(2)
+    assert "DisabledByStandbyHelm" in loop.values("IVPHELM_ALLSTOP")
+    assert loop.values("IVPHELM_STATE")[-1] == "DISABLED"
+    assert loop.values("IVPHELM_STATE").count("DISABLED") == 1  # posted on change only
+    assert loop.last("DESIRED_SPEED") == 0.0
+
+
+def test_stale_mail_is_dropped_with_ivphelm_skew(tmp_path: Path) -> None:
+    loop = CoreLoop(make_helm(tmp_path, FLAGS, start_engaged="true", ok_skew="30"), KinematicModel())
+    loop.run(1)
+    loop._deliver(loop.helm.handle_mail("GO", "true", loop.t - 100, "uPokeDB", loop.t))
+    loop.run(1)
+    assert loop.values("RUN") == [] and loop.values("IVPHELM_SKEW")
+
+
+def test_alias_names_the_app_and_falls_back_to_the_phelmivp_block(tmp_path: Path) -> None:
+    clock = MoosClock(WARP)
+    bhv = tmp_path / "h.bhv"
+    bhv.write_text("Behavior = BHV_ConstantSpeed\n{\n name = s\n speed = 1\n duration = no-time-limit\n}\n")
+    with running_moosdb("alpha", warp=WARP) as db, observer(db.port, clock, ["IVPHELM_STATE"]) as obs:
+        mission = write_mission(tmp_path, db.port, bhv)
+        with HelmApp(mission, alias="pHelmIvP_backup", clock=clock) as app:
+            assert app.state == "PARK"
+            assert obs.wait(lambda: obs.values("IVPHELM_STATE"))
+            assert {src for _, name, _, src in obs.mail if name == "IVPHELM_STATE"} == {"pHelmIvP_backup"}
