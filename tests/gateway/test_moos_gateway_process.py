@@ -11,8 +11,9 @@ import signal
 
 import pytest
 from gateway_plugin_sources import ECHO_PLUGIN
+from moosdb_kinds import any_moosdb, real_moosdb_skip_reason
 
-from gateway.moos.testing import collect_mail, connected_comms, moosdb_process
+from gateway.moos.testing import collect_mail, connected_comms
 from gateway.portal.testing import PortalClient, broker_process
 from translators.moos_interface import TIME_VAR
 from translators.testing import GatewayProcess
@@ -33,11 +34,15 @@ def _moos_to_goby(poster, peer: PortalClient, got: list[str], tag: str, buffered
     raise AssertionError(f"no {tag} message came through the gateway; got {got}")
 
 
-@pytest.mark.parametrize("stop_signal", [signal.SIGTERM, signal.SIGINT])
-def test_gateway_process_end_to_end(tmp_path, stop_signal):
+REAL = pytest.param("real", signal.SIGTERM, marks=[
+    pytest.mark.interop, pytest.mark.skipif(real_moosdb_skip_reason() is not None, reason=str(real_moosdb_skip_reason()))])
+
+
+@pytest.mark.parametrize(("moosdb_kind", "stop_signal"), [("ours", signal.SIGTERM), ("ours", signal.SIGINT), REAL])
+def test_gateway_process_end_to_end(tmp_path, moosdb_kind, stop_signal):
     plugin = tmp_path / "echo_plugin.py"
     plugin.write_text(ECHO_PLUGIN)
-    with moosdb_process(tmp_path) as db, broker_process(tmp_path, platform="gwe2e") as broker:
+    with any_moosdb(moosdb_kind, tmp_path) as db, broker_process(tmp_path, platform="gwe2e") as broker:
         gateway = GatewayProcess(tmp_path, [str(plugin)], _gateway_config(broker, db.port), extra_args=["-v"])
         with gateway, PortalClient(broker.interprocess_config(), name="peer") as peer, \
                 connected_comms(db.port, "poster", register=["OUT", "OUT_LOWER", TIME_VAR]) as poster:
