@@ -168,6 +168,10 @@ class Behavior:
         names: set[str] = {"NAV_X", "NAV_Y", "NAV_HEADING", "NAV_SPEED"}
         for cond in self.conditions:
             names |= cond.variables()
+        for flags in self.flags.values():
+            for flag in flags:
+                if flag.condition is not None:
+                    names |= flag.condition.variables()
         if self.updates_var:
             names.add(self.updates_var)
         if self.duration_reset:
@@ -219,7 +223,8 @@ class Behavior:
     def post_flags(self, kind: str, repeatable: bool = True) -> None:
         macros = self.macros()
         for flag in self.flags[kind]:
-            self.post(flag.var, flag.value(macros), repeatable=repeatable)
+            if flag.condition is None or flag.condition.evaluate(self.info.get):
+                self.post(flag.var, flag.value(macros), repeatable=repeatable)
 
     def macros(self) -> dict[str, Value]:
         """Flag macros; subclasses add their own (``NX``, ``CX``...)."""

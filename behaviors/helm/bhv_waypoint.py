@@ -168,7 +168,8 @@ class WaypointBehavior(Behavior):
     def _post_wpt_flags(self) -> None:
         macros = self.macros()
         for flag in self.wpt_flags:
-            self.post(flag.var, flag.value(macros))
+            if flag.condition is None or flag.condition.evaluate(self.info.get):
+                self.post(flag.var, flag.value(macros))
 
     # ---- states --------------------------------------------------------------------------------
     def on_run_to_idle_state(self) -> None:
@@ -197,7 +198,8 @@ class WaypointBehavior(Behavior):
             self.post(self.var_status + self.suffix, f"behavior-name={self.name},{result}")
             macros = self.macros()
             for flag in self.cycle_flags:
-                self.post(flag.var, flag.value(macros), repeatable=True)
+                if flag.condition is None or flag.condition.evaluate(self.info.get):
+                    self.post(flag.var, flag.value(macros), repeatable=True)
         if (eng.target != this_pt or hit or (self.wptflag_on_start and not self._wpt_flag_published)
                 or result == "completed"):
             self._prevpt = this_pt

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 from .errors import ParamError
 from .geometry import fmt_num
-from .logic import is_number
+from .logic import LogicCondition, is_number
 
 _MACRO = re.compile(r"\$[\[(]([A-Za-z0-9_]+)[\])]")
 Value = float | str
@@ -16,10 +16,11 @@ Value = float | str
 
 @dataclass(frozen=True)
 class Flag:
-    """``VAR = value``; the value keeps its text so macros can be expanded at posting time."""
+    """``VAR = value [if] condition``; the value keeps its text so macros can be expanded at posting time."""
 
     var: str
     text: str
+    condition: LogicCondition | None = None
 
     @classmethod
     def parse(cls, spec: str) -> Flag:
@@ -28,11 +29,15 @@ class Flag:
             raise ParamError(f"flag '{spec}': inter-vehicle destinations (#group, #all) are not supported")
         if spec.startswith("@"):
             raise ParamError(f"flag '{spec}': post tags (@tag) are for contact behaviours, not supported")
+        condition = None
+        if "[if]" in spec:
+            spec, cond_text = (part.strip() for part in spec.split("[if]", 1))
+            condition = LogicCondition(cond_text)
         var, sep, value = spec.partition("=")
         var = var.strip()
-        if not sep or not var or any(c.isspace() for c in var):
+        if not sep or not var or not value.strip() or any(c.isspace() for c in var):
             raise ParamError(f"flag '{spec}': expected VAR = value")
-        return cls(var, value.strip())
+        return cls(var, value.strip(), condition)
 
     def value(self, macros: Mapping[str, Value]) -> Value:
         """The value to post: macros expanded; a number (or a lone macro that is one) posts as a double."""

@@ -25,6 +25,8 @@ Behavior = BHV_ConstantHeading
   activeflag = ACT = 1
   inactiveflag = INACT = $[CTR]
   idleflag = IDLE = yes
+  activeflag = COND_FLAG = on [if] GO = true
+  activeflag = NEVER = on [if] GO = maybe
   updates = HDG_UPDATES
 }
 Behavior = BHV_ConstantSpeed
@@ -46,6 +48,7 @@ def test_flag_timing_and_visibility_on_the_next_iteration(tmp_path: Path) -> Non
     loop.poke("GO", "true")
     loop.run(0.1)  # one iteration
     assert loop.values("RUN") == ["hdg"] and loop.values("ACT") == [1.0]
+    assert loop.values("COND_FLAG") == ["on"] and loop.values("NEVER") == []  # [if] conditional flags
     assert loop.values("SAW_ACT") == []  # flags enter the info buffer after every behaviour has run
     loop.run(0.1)
     assert loop.values("SAW_ACT") == ["true"]
