@@ -12,6 +12,7 @@ from gateway.portal.errors import (
     MarshallingError,
     PortalError,
     ThreadError,
+    WrongThreadError,
 )
 from gateway.portal.group import BROADCAST_GROUP, INVALID_NUMERIC_GROUP, Group
 from gateway.portal.interface_registry import InterfaceEntry, InterfaceRegistry, process_registry
@@ -45,6 +46,7 @@ __all__ = [
     "SingleThreadApplication",
     "SystemClock",
     "ThreadError",
+    "WrongThreadError",
     "clock",
     "current_context",
     "process_registry",

@@ -33,3 +33,7 @@ class ClosedError(PortalError):
 
 class ThreadError(PortalError):
     """A thread launched by an application failed to start."""
+
+
+class WrongThreadError(PortalError):
+    """A transporter method called from a thread other than its owner (hand the work over with ``call_soon``)."""

@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 import os
 import re
+import threading
 import time
 from collections import deque
 from collections.abc import Callable, Iterable
@@ -22,7 +23,7 @@ import zmq
 
 from gateway.portal.context import ProcessContext
 from gateway.portal.endpoints import MANAGER_REQUEST_GROUP, MANAGER_RESPONSE_GROUP
-from gateway.portal.errors import ClosedError, IdentifierError, MarshallingError
+from gateway.portal.errors import ClosedError, IdentifierError, MarshallingError, WrongThreadError
 from gateway.portal.group import GroupLike, as_group, check_named
 from gateway.portal.identifier import (
     EVERYTHING,
@@ -78,6 +79,7 @@ class InterProcessPortal:
         self._thread_name = thread_name
         self._pid = os.getpid()
         self._thread_hex = thread_id()
+        self._owner = threading.get_ident()
         self._subs: dict[bytes, list[_Subscription]] = {}
         self._regex: list[_RegexSubscription] = []
         self._held: deque[bytes] = deque()
@@ -415,6 +417,8 @@ class InterProcessPortal:
 
     def _malformed(self, frame: bytes, why: str) -> None:
         self.malformed += 1
+        if self.malformed > 10 and self.malformed % 1000:
+            return  # a flood: log the first ten, then every thousandth (the count says how many)
         log.error("%s: dropping malformed frame (%d so far): %s: %r", self._thread_name, self.malformed, why,
                   frame[:80])
 
@@ -453,6 +457,11 @@ class InterProcessPortal:
     def _check_open(self) -> None:
         if self._closed:
             raise ClosedError(f"interprocess portal of {self._thread_name} is closed")
+        if threading.get_ident() != self._owner:
+            raise WrongThreadError(
+                f"interprocess portal of {self._thread_name} used from thread {threading.current_thread().name!r}; "
+                "ZeroMQ sockets belong to their thread: hand the work over with call_soon()"
+            )
 
     @property
     def connected(self) -> bool:

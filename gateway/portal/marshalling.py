@@ -57,12 +57,21 @@ def is_dccl(msg_type: type) -> bool:
 
 
 def default_scheme(msg_type: type) -> int:
-    """The scheme a type travels with on interprocess (DCCL is replaced by PROTOBUF there, as in Goby)."""
+    """Goby's ``scheme<T>()``: DCCL for DCCL-annotated protobuf, PROTOBUF for other protobuf, CSTR for str.
+
+    Interprocess replaces DCCL by PROTOBUF (``interprocess_scheme``), as Goby's interprocess transporter does.
+    """
     if issubclass(msg_type, pb_message.Message):
-        return Scheme.PROTOBUF
+        return Scheme.DCCL if is_dccl(msg_type) else Scheme.PROTOBUF
     if issubclass(msg_type, (str, bytes)):
         return Scheme.CSTR
     raise MarshallingError(f"no marshalling scheme for {msg_type.__qualname__}: use a protobuf message or str")
+
+
+def interprocess_scheme(msg_type: type) -> int:
+    """The scheme a type travels with on interprocess: DCCL becomes PROTOBUF."""
+    scheme = default_scheme(msg_type)
+    return Scheme.PROTOBUF if scheme == Scheme.DCCL else scheme
 
 
 def type_name(msg_type: type, scheme: int) -> str:

@@ -8,6 +8,8 @@ from gateway.portal import Group, InvalidGroupError, MarshallingError, Scheme
 from gateway.portal.group import INVALID_NUMERIC_GROUP, as_group, check_named
 from gateway.portal.marshalling import (
     default_scheme,
+    interprocess_scheme,
+    is_dccl,
     parse,
     parse_dynamic,
     scheme_from_string,
@@ -15,7 +17,7 @@ from gateway.portal.marshalling import (
     serialize,
     type_name,
 )
-from gateway.portal.protobuf.test_messages_pb2 import Sample
+from gateway.portal.protobuf.test_messages_pb2 import DCCLSample, Sample
 
 
 def test_group_wire_strings() -> None:
@@ -77,3 +79,10 @@ def test_cstr_marshalling_keeps_goby_trailing_nul() -> None:
     assert parse(b"HI\0", Scheme.CSTR, str) == "HI"
     with pytest.raises(MarshallingError):
         default_scheme(dict)
+
+
+def test_dccl_messages_default_to_dccl_but_travel_as_protobuf_on_interprocess() -> None:
+    assert is_dccl(DCCLSample) and not is_dccl(Sample)
+    assert default_scheme(DCCLSample) == Scheme.DCCL
+    assert interprocess_scheme(DCCLSample) == Scheme.PROTOBUF
+    assert interprocess_scheme(str) == Scheme.CSTR

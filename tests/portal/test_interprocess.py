@@ -10,7 +10,7 @@ import pytest
 
 from gateway.portal import Scheme
 from gateway.portal.marshalling import parse_dynamic
-from gateway.portal.protobuf.test_messages_pb2 import Sample, Widget
+from gateway.portal.protobuf.test_messages_pb2 import DCCLSample, Sample, Widget
 from gateway.portal.testing import AppProcess, BrokerProcess, PortalClient, broker_process
 
 REPO = Path(__file__).resolve().parents[2]
@@ -157,3 +157,15 @@ def test_multithread_app_thread_gets_callbacks_and_relays_on_interthread(
         assert tx.poll_until(relayed, 30), app.stderr_text()
         assert app.stop() == 0
     assert any(line.startswith("RX mt ") for line in app.lines)
+
+
+def test_dccl_message_travels_as_protobuf(broker: BrokerProcess) -> None:
+    with PortalClient(broker.interprocess_config(), "dccl_client") as client:
+        typed = client.collect("dccl", DCCLSample)
+        raw: list[tuple[int, str]] = []
+        client.portal.subscribe_regex(lambda d, s, t, g: raw.append((s, t)), group_regex="dccl")
+        assert client.wait_subscribed()
+        client.publish("dccl", DCCLSample(a=12))
+        assert client.poll_until(lambda: bool(typed) and bool(raw), 20)
+    assert typed[0].a == 12
+    assert raw == [(Scheme.PROTOBUF, "goby.test.zeromq.protobuf.DCCLSample")]

@@ -89,6 +89,28 @@ def test_interthread_delivers_on_subscriber_threads_without_echo() -> None:
             w1.interthread().publish("", Sample())
 
 
+class RegexWorker(SimpleThread):
+    def __init__(self, cfg: Any) -> None:
+        super().__init__(cfg)
+        self.hits: list[tuple[str, str, int]] = []
+        self.interthread().subscribe_regex(lambda obj, scheme, tname, group: self.hits.append((group, tname, scheme)),
+                                           group_regex="work|other", type_regex=".*Sample")
+
+
+def test_interthread_regex_subscription() -> None:
+    with running_app(InterthreadOnly, no_interprocess_cfg()) as app:
+        rx = app.launch_thread(RegexWorker, SampleAppConfig())
+        tx = app.launch_thread(Worker, SampleAppConfig())
+        for group in ("work", "other", "workx"):
+            tx.call_soon(lambda g=group: tx.interthread().publish(g, Sample(a=1)))
+        tx.call_soon(lambda: tx.interthread().publish("other", "a string"))
+        tx.call_soon(lambda: tx.interthread().publish("other", Sample(a=2)))
+        assert wait_until(lambda: len(rx.hits) == 3)
+        time.sleep(0.1)
+    assert rx.hits == [("work", "goby.test.zeromq.protobuf.Sample", 5), ("other", "goby.test.zeromq.protobuf.Sample", 5),
+                       ("other", "goby.test.zeromq.protobuf.Sample", 5)]
+
+
 class Broken(SimpleThread):
     def __init__(self, cfg: Any) -> None:
         raise RuntimeError("no hardware")

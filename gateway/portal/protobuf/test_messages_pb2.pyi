@@ -1,5 +1,6 @@
 from gateway.protobuf import app_config_pb2 as _app_config_pb2
 from gateway.protobuf import interprocess_config_pb2 as _interprocess_config_pb2
+from gateway.protobuf.include.dccl import option_extensions_pb2 as _option_extensions_pb2
 from google.protobuf.internal import containers as _containers
 from google.protobuf import descriptor as _descriptor
 from google.protobuf import message as _message
@@ -29,6 +30,12 @@ class Widget(_message.Message):
     B_FIELD_NUMBER: _ClassVar[int]
     b: int
     def __init__(self, b: _Optional[int] = ...) -> None: ...
+
+class DCCLSample(_message.Message):
+    __slots__ = ("a",)
+    A_FIELD_NUMBER: _ClassVar[int]
+    a: int
+    def __init__(self, a: _Optional[int] = ...) -> None: ...
 
 class SampleAppConfig(_message.Message):
     __slots__ = ("app", "interprocess", "role", "count", "group", "publish_period")
