@@ -34,6 +34,9 @@ class GobyMOOSGateway(MultiThreadApplication):
 
     def __init__(self, cfg: GobyMOOSGatewayConfig, plugins: list[Plugin]) -> None:
         super().__init__(cfg)
+        if cfg.HasField("poll_frequency"):
+            log.info("poll_frequency %g is ignored, as in Goby: translators loop at 10 Hz x warp and handle MOOS "
+                     "mail as soon as it arrives", cfg.poll_frequency)
         self._loaded: list[Plugin] = []
         for plugin in plugins:
             try:

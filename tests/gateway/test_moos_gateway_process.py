@@ -8,12 +8,13 @@ from __future__ import annotations
 
 import re
 import signal
+import time
 
 import pytest
 from gateway_plugin_sources import ECHO_PLUGIN
 from moosdb_kinds import any_moosdb, real_moosdb_skip_reason
 
-from gateway.moos.testing import collect_mail, connected_comms
+from gateway.moos.testing import collect_mail, connected_comms, moosdb_process
 from gateway.portal.testing import PortalClient, broker_process
 from translators.moos_interface import TIME_VAR
 from translators.testing import GatewayProcess
@@ -80,3 +81,25 @@ def test_gateway_process_end_to_end(tmp_path, moosdb_kind, stop_signal):
 
             assert gateway.stop(stop_signal) == 0, gateway.stderr()
         assert "Traceback" not in gateway.stderr()
+
+
+def test_warp_speeds_up_the_translator_clock(tmp_path):
+    """With ``use_sim_time`` and warp 10, the loop runs at 100 Hz and the time variable comes ~10 times a second,
+    carrying warped MOOS and Goby times."""
+    plugin = tmp_path / "echo_plugin.py"
+    plugin.write_text(ECHO_PLUGIN)
+    with moosdb_process(tmp_path, warp=10) as db, broker_process(tmp_path, platform="gwwarp") as broker:
+        config = _gateway_config(broker, db.port) + " app { simulation { time { use_sim_time: true warp_factor: 10 } } }"
+        with GatewayProcess(tmp_path, [str(plugin)], config), \
+                connected_comms(db.port, "watcher", register=[TIME_VAR]) as watcher:
+            assert collect_mail(watcher, [TIME_VAR], until=1, timeout=30)  # the translator is up
+            start = time.time()
+            posts = collect_mail(watcher, [TIME_VAR], until=lambda got: time.time() - start > 2.0, timeout=10)
+    assert len(posts) >= 6, [p.string() for p in posts]  # warp 1 would give 2
+    values = [re.fullmatch(r"moostime=([0-9.e+]+),gobytime=([0-9.e+]+)\n", p.string()) for p in posts]
+    goby_times = [float(v.group(2)) for v in values]
+    moos_times = [float(v.group(1)) for v in values]
+    assert moos_times[-1] - moos_times[0] > 5.0  # MOOS time is warped too (SetMOOSTimeWarp)
+    # warped Goby time runs ahead of real time (Goby's warp is relative to the start of the year)
+    assert goby_times[-1] - goby_times[0] > 5.0
+    assert goby_times[-1] > time.time() + 60
