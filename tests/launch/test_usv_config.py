@@ -55,7 +55,6 @@ def test_frontseat_and_gateway_point_at_the_same_moosdb_and_simulator(settings):
     assert helm.port == gw.moos.port == 9123
     assert sim.tcp_port == int(generate("frontseat_sim", settings)) == 55123
     assert (sim.start.lat, sim.start.lon) == (41.5, -70.7)
-    assert fs.frontseat_cfg.sim_warp_factor == 17
 
 
 def test_moos_file_matches_the_goby_side(settings):
