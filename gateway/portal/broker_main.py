@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 import signal
 import sys
 import threading
@@ -54,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
         except BrokerError as exc:
             log.critical("%s", exc)
             return 1
-        info = {"platform": cfg.interprocess.platform, **broker.endpoints(), "pid": _pid()}
+        info = {"platform": cfg.interprocess.platform, **broker.endpoints(), "pid": os.getpid()}
         print(READY_PREFIX + json.dumps(info), flush=True)
         log.info("=== goby-broker is ready ===")
         while not stop.wait(1.0):
@@ -64,12 +65,6 @@ def main(argv: list[str] | None = None) -> int:
         broker.stop()
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-
-
-def _pid() -> int:
-    import os
-
-    return os.getpid()
 
 
 if __name__ == "__main__":

@@ -67,7 +67,11 @@ def build_parser(config_type: type[pb_message.Message], prog: str | None = None)
     add_verbosity_argument(parser)
     for field in config_type.DESCRIPTOR.fields:
         kind = "message (text format)" if field.type == _FD.TYPE_MESSAGE else _type_label(field)
-        parser.add_argument(f"--{field.name}", action="append", metavar="VALUE", help=f"override {field.name}: {kind}")
+        try:
+            parser.add_argument(f"--{field.name}", action="append", metavar="VALUE", dest=f"field_{field.name}",
+                                help=f"override {field.name}: {kind}")
+        except argparse.ArgumentError:
+            pass  # a field named like a common option (e.g. "verbose"): set it in the file or a message block
     return parser
 
 
@@ -90,7 +94,7 @@ def load_config(
             raise ConfigError(f"cannot read configuration file {path}: {exc.strerror}") from None
         _merge_text(cfg, text, f"configuration file {path}")
     for field in config_type.DESCRIPTOR.fields:
-        for value in getattr(args, field.name) or ():
+        for value in getattr(args, f"field_{field.name}", None) or ():
             if field.type == _FD.TYPE_MESSAGE:
                 target = getattr(cfg, field.name).add() if _is_repeated(field) else getattr(cfg, field.name)
                 _merge_text(target, value, f"--{field.name}")
