@@ -69,8 +69,19 @@ def plugin_entries_from_env(environ: Mapping[str, str] | None = None) -> list[st
 
 
 def resolve_plugins(entries: list[str]) -> list[Plugin]:
-    """Resolve every entry in order; the first failure raises PluginError (nothing is half-loaded)."""
-    return [resolve_plugin(entry) for entry in entries]
+    """Resolve every entry in order; the first failure raises PluginError (nothing is half-loaded).
+
+    The same module named twice is an error, as in Goby (where the second ``launch_thread`` of a type throws).
+    """
+    plugins: list[Plugin] = []
+    for entry in entries:
+        plugin = resolve_plugin(entry)
+        for earlier in plugins:
+            if earlier.module is plugin.module:
+                raise PluginError(f"plugin {entry}: module {plugin.module.__name__} is already loaded as "
+                                  f"{earlier.entry} (listed twice in {ENV_VAR})")
+        plugins.append(plugin)
+    return plugins
 
 
 def resolve_plugin(entry: str) -> Plugin:
@@ -133,6 +144,8 @@ def _import_file(entry: str) -> ModuleType:
         raise PluginError(f"Failed to open plugin: {entry}, reason: no such file")
     digest = hashlib.sha1(str(path.resolve()).encode()).hexdigest()[:10]
     name = f"goby_moos_gateway_plugin_{path.stem}_{digest}"
+    if name in sys.modules:  # the same file again: the same module, as a second dlopen gives the same handle
+        return sys.modules[name]
     spec = importlib.util.spec_from_file_location(name, path)
     if spec is None or spec.loader is None:
         raise PluginError(f"Failed to open plugin: {entry}, reason: not a Python module")

@@ -4,6 +4,7 @@ exit status 1 and a message naming the plugin and the cause."""
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -69,12 +70,13 @@ def test_entry_points_are_selected_by_name_only():
         (NO_LOAD_PLUGIN, "{dir}/no_load.py", "Function load in plugin: {dir}/no_load.py does not exist"),
         (IMPORT_ERROR_PLUGIN, "{dir}/import_error.py", "reason: ModuleNotFoundError: No module named 'no_such_dependency_xyz'"),
         (ECHO_PLUGIN, "{dir}/echo.py:", "Failed to open plugin: '', reason: empty entry"),
+        (ECHO_PLUGIN, "{dir}/echo.py,{dir}/echo.py", "is already loaded as {dir}/echo.py (listed twice"),
     ],
 )
 def test_resolution_errors_name_the_plugin(tmp_path, source, entry, cause):
     entry = entry.format(dir=tmp_path)
     if source is not None:
-        Path(entry.rstrip(":")).write_text(source)
+        Path(re.split("[:,]", entry)[0]).write_text(source)
     with pytest.raises(PluginError) as info:
         resolve_plugins(split_plugin_list(entry))
     assert cause.format(dir=tmp_path) in str(info.value)
