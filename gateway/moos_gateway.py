@@ -29,7 +29,8 @@ class PluginLoadError(PluginError):
 class GobyMOOSGateway(MultiThreadApplication):
     """The gateway's main thread: owns the interprocess portal and runs no loop (0 Hz), as Goby's.
 
-    ``plugins`` are loaded in order in the constructor; translators are the threads they launch.
+    ``plugins`` are loaded in order in the constructor, on the thread constructing the gateway (the process's main
+    thread under ``main``); translators are the threads they launch.  ``unload`` runs on the thread that closes it.
     """
 
     def __init__(self, cfg: GobyMOOSGatewayConfig, plugins: list[Plugin]) -> None:
