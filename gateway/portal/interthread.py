@@ -119,8 +119,12 @@ class InterThreadTransporter:
         self._thread_name = thread_name
         self._registry = registry if registry is not None else process_registry
         self._application = application
+        self._recorded: set[tuple[str, str, str]] = set()
 
     def _record(self, direction: str, group: str, key: str) -> None:
+        if (direction, group, key) in self._recorded:
+            return
+        self._recorded.add((direction, group, key))
         self._registry.record(
             InterfaceEntry(LAYER, direction, group, Scheme.CXX_OBJECT.name, key, self._thread_name, self._application)
         )

@@ -110,7 +110,8 @@ class SimpleThread:
         """Run ``fn()`` on this thread as soon as possible; callable from any thread.
 
         Wakes the thread's poll through an eventfd, so the delay is the wake-up time of the thread (tens of µs),
-        not a loop period.  Exceptions from ``fn`` are logged and the thread keeps running.
+        not a loop period.  Exceptions from ``fn`` are logged and the thread keeps running.  Raises
+        ``ClosedError`` once the thread has closed (work handed over during shutdown is not dropped silently).
         """
         self._transports.mailbox.post(fn)
 

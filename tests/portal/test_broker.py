@@ -153,3 +153,23 @@ def test_in_process_broker_start_stop_is_idempotent(tmp_path: Path) -> None:
             request_endpoints(zctx, cfg.interprocess, "c", timeout_s=10)
     broker.stop()
     assert BrokerProcess(tmp_path, "x").stop() is None
+
+
+def test_manager_survives_malformed_requests(broker: BrokerProcess, capfd: pytest.CaptureFixture[str]) -> None:
+    endpoint = f"ipc://{broker.socket_base}.manager"
+    with zmq.Context() as zctx:
+        req = zctx.socket(zmq.REQ)
+        req.setsockopt(zmq.LINGER, 0)
+        req.connect(endpoint)
+        req.send(b"\xff\x00garbage")
+        assert req.poll(10_000)
+        assert req.recv() == b""  # REP must answer; the error is logged by the broker
+        req.send(ManagerRequest(request=PROVIDE_HOLD_STATE).SerializePartialToString())  # required fields missing
+        assert req.poll(10_000)
+        assert req.recv() == b""
+        req.close()
+        pub, _, _ = request_endpoints(zctx, broker.interprocess_config(), "after_garbage", timeout_s=10)
+    assert pub.endswith(".xsub")
+    broker.stop()
+    err = capfd.readouterr().err
+    assert "malformed ManagerRequest" in err and "missing client_name, client_pid" in err
