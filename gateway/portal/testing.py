@@ -48,7 +48,7 @@ class BrokerProcess:
     """A ``goby-broker`` subprocess; ``start``/``stop``/``kill``/``restart`` may be called repeatedly."""
 
     def __init__(self, directory: Path, platform: str = "test", tcp: bool = False, extra_args: list[str] | None = None,
-                 startup_timeout: float = 30.0) -> None:
+                 startup_timeout: float = 30.0, log_path: str | os.PathLike[str] | None = None) -> None:
         self.platform = platform
         self.tcp = tcp
         self._own_dir: str | None = None
@@ -60,6 +60,7 @@ class BrokerProcess:
         self.extra_args = list(extra_args or [])
         self.startup_timeout = startup_timeout
         self.process: subprocess.Popen[str] | None = None
+        self.log_path = Path(log_path) if log_path is not None else None
         self.endpoints: dict[str, Any] = {}
         self.manager_port = 0
 
@@ -95,7 +96,11 @@ class BrokerProcess:
             cfg.tcp_port = 0
         args = [sys.executable, "-m", "gateway.portal.broker_main",
                 "--interprocess", text_format.MessageToString(cfg, as_one_line=True), *self.extra_args]
-        self.process = subprocess.Popen(args, stdout=subprocess.PIPE, text=True)
+        if self.log_path is not None:
+            with open(self.log_path, "a") as log_file:  # the child keeps its own copy of the descriptor
+                self.process = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=log_file, text=True)
+        else:
+            self.process = subprocess.Popen(args, stdout=subprocess.PIPE, text=True)
         line = self._read_ready_line()
         self.endpoints = json.loads(line[len(READY_PREFIX):])
         if self.tcp and not self.manager_port:
@@ -145,6 +150,10 @@ class BrokerProcess:
             if proc.stdout is not None:
                 proc.stdout.close()
 
+    def stderr_text(self) -> str:
+        """The broker's log so far (only with ``log_path``)."""
+        return self.log_path.read_text() if self.log_path is not None and self.log_path.exists() else ""
+
     def restart(self) -> BrokerProcess:
         self.stop()
         return self.start()
@@ -164,9 +173,13 @@ class BrokerProcess:
 
 @contextmanager
 def broker_process(tmp_path: Path, platform: str = "test", tcp: bool = False,
-                   extra_args: list[str] | None = None) -> Iterator[BrokerProcess]:
-    """Start ``goby-broker`` on an IPC path in ``tmp_path`` (or TCP on 127.0.0.1), yield it, stop it."""
-    broker = BrokerProcess(tmp_path, platform, tcp, extra_args)
+                   extra_args: list[str] | None = None, log_path: str | os.PathLike[str] | None = None
+                   ) -> Iterator[BrokerProcess]:
+    """Start ``goby-broker`` on an IPC path in ``tmp_path`` (or TCP on 127.0.0.1), yield it, stop it.
+
+    The broker's log goes to ``log_path`` if given (read it with ``stderr_text()``), else to this process's stderr.
+    """
+    broker = BrokerProcess(tmp_path, platform, tcp, extra_args, log_path=log_path)
     with broker:
         yield broker
 

@@ -155,7 +155,15 @@ def test_in_process_broker_start_stop_is_idempotent(tmp_path: Path) -> None:
     assert BrokerProcess(tmp_path, "x").stop() is None
 
 
-def test_manager_survives_malformed_requests(broker: BrokerProcess, capfd: pytest.CaptureFixture[str]) -> None:
+def test_manager_survives_malformed_requests(tmp_path: Path) -> None:
+    with broker_process(tmp_path, platform="garbage", log_path=tmp_path / "broker.log") as broker:
+        _garbage_then_valid(broker)
+        broker.stop()
+        err = broker.stderr_text()
+    assert "malformed ManagerRequest" in err and "missing client_name, client_pid" in err
+
+
+def _garbage_then_valid(broker: BrokerProcess) -> None:
     endpoint = f"ipc://{broker.socket_base}.manager"
     with zmq.Context() as zctx:
         req = zctx.socket(zmq.REQ)
@@ -170,6 +178,3 @@ def test_manager_survives_malformed_requests(broker: BrokerProcess, capfd: pytes
         req.close()
         pub, _, _ = request_endpoints(zctx, broker.interprocess_config(), "after_garbage", timeout_s=10)
     assert pub.endswith(".xsub")
-    broker.stop()
-    err = capfd.readouterr().err
-    assert "malformed ManagerRequest" in err and "missing client_name, client_pid" in err
