@@ -44,10 +44,12 @@ class USVManager(SingleThreadApplication):
             log.error("refusing USVCommand %s: %s", text, error)
             ack.stage = USVCommandAck.REFUSED
             ack.error = str(error)
-        else:
-            self.interprocess().publish(groups.usv_command, checked)
-            ack.stage = USVCommandAck.RECEIVED_BY_MANAGER
+            self.interprocess().publish(groups.usv_command_ack, ack)
+            return
+        # Ack first: from one publisher the broker keeps order, so the sender hears from us before the translator.
+        ack.stage = USVCommandAck.RECEIVED_BY_MANAGER
         self.interprocess().publish(groups.usv_command_ack, ack)
+        self.interprocess().publish(groups.usv_command, checked)
 
 
 def main(argv: list[str] | None = None) -> int:
