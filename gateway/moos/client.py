@@ -21,7 +21,7 @@ from collections.abc import Callable
 
 from .active_queue import ActiveQueueRouter, MessageCallback
 from .clock import DEFAULT_CLOCK, MoosClock
-from .codec import encode_packet
+from .codec import encode_message, frame_packet
 from .connection import PacketSocket, Welcome, client_handshake, open_socket
 from .errors import ConnectionClosedError, HandshakeError, MoosError, PoisonedError, ProtocolError
 from .message import (
@@ -65,10 +65,17 @@ class comms:  # noqa: N801 - pymoos's class name
     def __init__(self, asynchronous: bool = True, clock: MoosClock | None = None) -> None:
         self._async = asynchronous
         self._clock = clock or DEFAULT_CLOCK
-        self._cond = threading.Condition()
-        self._outbox: list[MoosMessage] = []
+        self._lock = threading.Lock()
+        self._cond = threading.Condition(self._lock)
+        self._outbox: list[bytes] = []  # encoded messages, in post order
         self._outbox_limit = DEFAULT_OUTBOX_LIMIT
         self._busy = False  # a thread is writing to the socket
+        self._live = False  # connected (a plain flag for the hot path; _connected is for waiting)
+        self._writer_waiting = False
+        self._space_waiters = 0
+        self._io_ident = -1
+        self._src = b""
+        self._keys: dict[str, bytes] = {}
         self._last_write = 0.0
         self._last_timing = 0.0
         self._out_delay = 0.0
@@ -111,11 +118,12 @@ class comms:  # noqa: N801 - pymoos's class name
     # ---- lifecycle ---------------------------------------------------------------------------------
     def run(self, server: str, port: int, name: str, comms_tick: float = 5) -> bool:
         """Start connecting to the DB at ``server:port`` as ``name``; returns at once (False if running)."""
-        with self._cond:
+        with self._lock:
             if self._running:
                 return False
             self._running = True
         self._host, self._port, self._name = server, int(port), name
+        self._src = to_bytes(name)
         if comms_tick:
             self.set_comms_tick(comms_tick)
         self._stop.clear()
@@ -128,14 +136,16 @@ class comms:  # noqa: N801 - pymoos's class name
 
     def close(self, nice: bool = True) -> bool:
         """Stop the client: with ``nice`` first wait (up to 2 s) for queued messages to be sent. Idempotent."""
-        if nice and self._connected.is_set():
+        if nice and self._live:
             deadline = _time.monotonic() + 2.0
-            with self._cond:
+            with self._lock:
+                self._space_waiters += 1
                 self._cond.notify_all()
-                while (self._outbox or self._busy) and self._connected.is_set() and _time.monotonic() < deadline:
+                while (self._outbox or self._busy) and self._live and _time.monotonic() < deadline:
                     self._cond.wait(0.05)
+                self._space_waiters -= 1
         self._stop.set()
-        with self._cond:
+        with self._lock:
             conn = self._conn
             self._cond.notify_all()
         if conn is not None:
@@ -147,7 +157,7 @@ class comms:  # noqa: N801 - pymoos's class name
             if thread is not None and thread is not me:
                 thread.join(10.0)
         self._queues.stop_all()
-        with self._cond:
+        with self._lock:
             self._running = False
             self._outbox.clear()
         self._registered.clear()
@@ -233,10 +243,9 @@ class comms:  # noqa: N801 - pymoos's class name
                 log.warning("notify %s: string value truncated at its first NUL byte, as MOOS does; "
                             "use notify_binary for arbitrary bytes", name)
                 raw = raw[:cut]
-            msg = MoosMessage(NOTIFY, STRING, key=to_bytes(name), msg_time=time, sval=raw)
+            msg = MoosMessage(NOTIFY, STRING, -1, b"", to_bytes(aux), b"", self._key(name), time, -1.0, -1.0, raw)
         else:
-            msg = MoosMessage(NOTIFY, DOUBLE, key=to_bytes(name), msg_time=time, dval=float(value))
-        msg.raw_aux = to_bytes(aux)
+            msg = MoosMessage(NOTIFY, DOUBLE, -1, b"", to_bytes(aux), b"", self._key(name), time, float(value))
         self._published.add(name)
         return self._post(msg)
 
@@ -328,7 +337,7 @@ class comms:  # noqa: N801 - pymoos's class name
 
     # ---- state -------------------------------------------------------------------------------------
     def is_connected(self) -> bool:
-        return self._connected.is_set()
+        return self._live
 
     def wait_until_connected(self, n_ms: float) -> bool:
         """Block until connected or ``n_ms`` milliseconds pass."""
@@ -418,20 +427,27 @@ class comms:  # noqa: N801 - pymoos's class name
         self._inbox_limit = max(1, int(limit))
 
     # ---- outgoing path -----------------------------------------------------------------------------
+    def _key(self, name: str) -> bytes:
+        raw = self._keys.get(name)
+        if raw is None:
+            raw = to_bytes(name)
+            if len(self._keys) < 10_000:
+                self._keys[name] = raw
+        return raw
+
     def _post(self, msg: MoosMessage, assign_id: bool = True) -> bool:
-        """Queue ``msg`` and get it written: directly if the link is idle, else by the writer thread."""
-        msg.raw_src = to_bytes(self._name)
-        on_io_thread = threading.current_thread() is self._io_thread
-        with self._cond:
-            if not self._connected.is_set():
+        """Queue ``msg`` (encoded at once) and get it written: directly if the link is idle, else by the writer."""
+        msg.raw_src = self._src
+        on_io_thread = threading.get_ident() == self._io_ident
+        with self._lock:
+            if not self._live:
                 return False
             if assign_id:
                 msg.msg_id = self._next_id
                 self._next_id += 1
-            if not on_io_thread:
-                while len(self._outbox) >= self._outbox_limit and self._connected.is_set() and not self._stop.is_set():
-                    self._cond.wait(0.1)
-            self._outbox.append(msg)
+            if not on_io_thread and len(self._outbox) >= self._outbox_limit:
+                self._wait_for_space()
+            self._outbox.append(encode_message(msg))
             direct = (
                 self._async
                 and not self._busy
@@ -441,50 +457,61 @@ class comms:  # noqa: N801 - pymoos's class name
             )
             if direct:
                 self._busy = True
-            else:
-                self._cond.notify_all()
+            elif self._writer_waiting:
+                self._cond.notify()
         if direct:
             self._drain()
         return True
 
-    def _take_batch(self) -> tuple[list[MoosMessage], PacketSocket | None]:
+    def _wait_for_space(self) -> None:
+        """Back-pressure: block (lock held by the caller) until the outbox drains below its limit."""
+        self._space_waiters += 1
+        try:
+            while len(self._outbox) >= self._outbox_limit and self._live and not self._stop.is_set():
+                if self._writer_waiting:
+                    self._cond.notify()
+                self._cond.wait(0.1)
+        finally:
+            self._space_waiters -= 1
+
+    def _take_batch(self) -> tuple[list[bytes], PacketSocket | None]:
         """Under the lock: everything queued, with the timing message in front when one is due."""
         batch, self._outbox = self._outbox, []
-        now = _time.monotonic()
-        if self._async and now - self._last_timing >= TIMING_PERIOD_S:
-            self._last_timing = now
-            batch.insert(0, MoosMessage(TIMING, DOUBLE, key=TIMING_KEY, msg_time=self._clock.local_time(), dval=0.0))
-        if len(batch) > self._outbox_limit:
+        if self._async:
+            now = _time.monotonic()
+            if now - self._last_timing >= TIMING_PERIOD_S:
+                self._last_timing = now
+                timing = MoosMessage(TIMING, DOUBLE, key=TIMING_KEY, msg_time=self._clock.local_time(), dval=0.0)
+                batch.insert(0, encode_message(timing))
+        if self._space_waiters:
             self._cond.notify_all()
         return batch, self._conn
 
     def _drain(self) -> None:
         """Write until the outbox is empty; the caller has set ``_busy``."""
         while True:
-            with self._cond:
-                if not self._outbox or self._conn is None or not self._connected.is_set():
+            with self._lock:
+                if not self._outbox or self._conn is None or not self._live:
                     self._busy = False
                     self._last_write = _time.monotonic()
-                    self._cond.notify_all()
+                    if self._space_waiters:
+                        self._cond.notify_all()
                     return
                 batch, conn = self._take_batch()
-                self._cond.notify_all()
             if not self._write(conn, batch):
-                with self._cond:
+                with self._lock:
                     self._busy = False
                     self._cond.notify_all()
                 return
 
-    def _write(self, conn: PacketSocket | None, batch: list[MoosMessage]) -> bool:
+    def _write(self, conn: PacketSocket | None, batch: list[bytes]) -> bool:
         if conn is None:
             return False
         try:
-            conn.send(encode_packet(batch))
+            conn.send(frame_packet(batch))
         except ConnectionClosedError as exc:
-            lost = [m for m in batch if m.msg_type != TIMING]
-            if lost:
-                log.warning("%s: %d message(s) not sent, the connection failed while writing: %s",
-                            self._name, len(lost), exc)
+            log.warning("%s: %d message(s) not sent, the connection failed while writing: %s",
+                        self._name, len(batch), exc)
             conn.shutdown()
             return False
         self._messages_sent += len(batch)
@@ -493,23 +520,27 @@ class comms:  # noqa: N801 - pymoos's class name
     def _writer_loop(self) -> None:
         """Async writer: batch what is queued, keep the timing message going, honour the DB's delay."""
         while not self._stop.is_set():
-            with self._cond:
+            with self._lock:
                 timing_due = self._last_timing + TIMING_PERIOD_S - _time.monotonic()
-                if self._busy or not self._connected.is_set() or (not self._outbox and timing_due > 0):
+                if self._busy or not self._live or (not self._outbox and timing_due > 0):
+                    self._writer_waiting = True
                     self._cond.wait(min(WRITER_IDLE_WAKE_S, max(timing_due, 0.001)))
+                    self._writer_waiting = False
                     continue
                 self._busy = True
                 batch, conn = self._take_batch()
             ok = self._write(conn, batch)
-            with self._cond:
+            with self._lock:
                 self._busy = False
                 self._last_write = _time.monotonic()
-                self._cond.notify_all()
+                if self._space_waiters:
+                    self._cond.notify_all()
             if ok and self._out_delay > 0.0:
                 self._stop.wait(self._out_delay)
 
     # ---- I/O thread --------------------------------------------------------------------------------
     def _io_loop(self) -> None:
+        self._io_ident = threading.get_ident()
         while not self._stop.is_set():
             try:
                 conn = PacketSocket(open_socket(self._host, self._port))
@@ -546,10 +577,11 @@ class comms:  # noqa: N801 - pymoos's class name
         if self._correct_time:
             self._clock.skew = welcome.skew
         self._packets_read = 0
-        with self._cond:
+        with self._lock:
             self._conn = conn
             self._last_timing = 0.0
             self._out_delay = 0.0
+            self._live = True
             self._connected.set()
             self._cond.notify_all()
         log.info("%s: connected to %s:%d (community %r)", self._name, self._host, self._port, self._community)
@@ -576,8 +608,9 @@ class comms:  # noqa: N801 - pymoos's class name
             self._wildcard(WILDCARD_REGISTER, var_pattern, app_pattern, interval)
 
     def _disconnected(self, conn: PacketSocket) -> None:
-        with self._cond:
-            was_connected = self._connected.is_set()
+        with self._lock:
+            was_connected = self._live
+            self._live = False
             self._connected.clear()
             self._conn = None
             self._bytes_sent_total += conn.bytes_sent
@@ -615,15 +648,15 @@ class comms:  # noqa: N801 - pymoos's class name
     def _exchange_sync(self, conn: PacketSocket) -> None:
         """Synchronous mode: one packet out (a NULL when idle), exactly one reply back, every comms tick."""
         while not self._stop.is_set():
-            with self._cond:
+            with self._lock:
                 batch, self._outbox = self._outbox, []
                 self._busy = bool(batch)
                 self._cond.notify_all()
             if not batch:
-                batch = [MoosMessage(NULL_MSG, DOUBLE, src=to_bytes(self._name))]
+                batch = [encode_message(MoosMessage(NULL_MSG, DOUBLE, src=self._src))]
             tx = self._clock.local_time()
             self._write(conn, batch)
-            with self._cond:
+            with self._lock:
                 self._busy = False
                 self._cond.notify_all()
             reply = conn.read_packet()
@@ -634,9 +667,11 @@ class comms:  # noqa: N801 - pymoos's class name
                     self._clock.update_skew(tx, reply[0].dval, rx)
             self._deliver(reply)
             period = 1.0 / (self._comms_tick * self._clock.warp)
-            with self._cond:
+            with self._lock:
                 if not self._outbox and not self._stop.is_set():
+                    self._writer_waiting = True
                     self._cond.wait(period)
+                    self._writer_waiting = False
 
     def _deliver(self, packet: list[MoosMessage]) -> None:
         """Route to active queues, append the rest to the inbox in order, then run the on-mail callback."""

@@ -27,9 +27,6 @@ _MSG_HEAD = Struct("<iicci")  # length, id, type, data type, len(src)
 _DOUBLES_AND_LEN = Struct("<dddi")  # time, val, val2, len(sval)
 _PKT_HEAD = Struct("<iiB")
 
-_pack_i32 = _I32.pack
-_pack_head = _MSG_HEAD.pack
-_pack_doubles = _DOUBLES_AND_LEN.pack
 _pack_pkt_head = _PKT_HEAD.pack
 _unpack_i32 = _I32.unpack_from
 _unpack_head = _MSG_HEAD.unpack_from
@@ -49,24 +46,28 @@ def message_size(msg: MoosMessage) -> int:
     )
 
 
+_head_structs: dict[tuple[int, int, int, int], Struct] = {}
+
+
+def _head_struct(n_src: int, n_aux: int, n_com: int, n_key: int) -> Struct:
+    """A compiled layout for everything up to the string payload, per combination of field lengths."""
+    fmt = f"<iicci{n_src}si{n_aux}si{n_com}si{n_key}sdddi"
+    compiled = Struct(fmt)
+    if len(_head_structs) < 4096:
+        _head_structs[(n_src, n_aux, n_com, n_key)] = compiled
+    return compiled
+
+
 def encode_message(msg: MoosMessage) -> bytes:
-    """Serialise one message exactly as ``CMOOSMsg::Serialize`` does."""
+    """Serialise one message exactly as ``CMOOSMsg::Serialize`` does (one struct pack plus the payload)."""
     src, aux, com, key, sval = msg.raw_src, msg.raw_aux, msg.raw_community, msg.raw_key, msg.raw_sval
     n_src, n_aux, n_com, n_key, n_sval = len(src), len(aux), len(com), len(key), len(sval)
-    return b"".join(
-        (
-            _pack_head(54 + n_src + n_aux + n_com + n_key + n_sval, msg.msg_id, msg.msg_type, msg.data_type, n_src),
-            src,
-            _pack_i32(n_aux),
-            aux,
-            _pack_i32(n_com),
-            com,
-            _pack_i32(n_key),
-            key,
-            _pack_doubles(msg.msg_time, msg.dval, msg.dval2, n_sval),
-            sval,
-        )
-    )
+    lengths = (n_src, n_aux, n_com, n_key)
+    head = _head_structs.get(lengths) or _head_struct(*lengths)
+    return head.pack(
+        54 + n_src + n_aux + n_com + n_key + n_sval, msg.msg_id, msg.msg_type, msg.data_type,
+        n_src, src, n_aux, aux, n_com, com, n_key, key, msg.msg_time, msg.dval, msg.dval2, n_sval,
+    ) + sval
 
 
 def frame_packet(encoded_messages: list[bytes]) -> bytes:
@@ -80,48 +81,51 @@ def encode_packet(messages: list[MoosMessage]) -> bytes:
     return frame_packet([encode_message(m) for m in messages])
 
 
-def _read_str(buf: bytes | bytearray | memoryview, pos: int, end: int) -> tuple[bytes, int]:
-    if pos + 4 > end:
-        raise ProtocolError(f"string length at offset {pos} overruns the message")
-    (n,) = _unpack_i32(buf, pos)
-    pos += 4
-    if n < 0 or pos + n > end:
-        raise ProtocolError(f"string of {n} bytes at offset {pos} overruns the message")
-    return bytes(buf[pos : pos + n]), pos + n
-
-
-def decode_message(buf: bytes | bytearray | memoryview, pos: int = 0, end: int | None = None) -> tuple[MoosMessage, int]:
-    """Parse one message starting at ``pos``; return it and the offset just after it."""
+def decode_message(buf: bytes, pos: int = 0, end: int | None = None) -> tuple[MoosMessage, int]:
+    """Parse one message starting at ``pos`` of ``buf`` (``bytes``); return it and the offset after it."""
     if end is None:
         end = len(buf)
     if pos + 14 > end:
         raise ProtocolError(f"message at offset {pos} is truncated ({end - pos} bytes left, need at least 54)")
     length, msg_id, msg_type, data_type, n = _unpack_head(buf, pos)
-    if length < MESSAGE_FIXED_SIZE or pos + length > end:
-        raise ProtocolError(f"message at offset {pos} claims {length} bytes but {end - pos} remain")
     stop = pos + length
+    if length < MESSAGE_FIXED_SIZE or stop > end:
+        raise ProtocolError(f"message at offset {pos} claims {length} bytes but {end - pos} remain")
+    # Each check keeps the next length field inside the message, so no read can stray past ``stop``.
     p = pos + 14
-    if n < 0 or p + n > stop:
+    q = p + n
+    if n < 0 or q + 40 > stop:
         raise ProtocolError(f"source string of {n} bytes at offset {p} overruns the message")
-    src = bytes(buf[p : p + n])
-    p += n
-    aux, p = _read_str(buf, p, stop)
-    com, p = _read_str(buf, p, stop)
-    key, p = _read_str(buf, p, stop)
-    if p + 28 > stop:
-        raise ProtocolError(f"message at offset {pos} is truncated before its numeric fields")
-    t, val, val2, n = _unpack_doubles(buf, p)
-    p += 28
+    src = buf[p:q]
+    (n,) = _unpack_i32(buf, q)
+    p = q + 4
+    q = p + n
+    if n < 0 or q + 36 > stop:
+        raise ProtocolError(f"aux string of {n} bytes at offset {p} overruns the message")
+    aux = buf[p:q]
+    (n,) = _unpack_i32(buf, q)
+    p = q + 4
+    q = p + n
+    if n < 0 or q + 32 > stop:
+        raise ProtocolError(f"community string of {n} bytes at offset {p} overruns the message")
+    com = buf[p:q]
+    (n,) = _unpack_i32(buf, q)
+    p = q + 4
+    q = p + n
+    if n < 0 or q + 28 > stop:
+        raise ProtocolError(f"key string of {n} bytes at offset {p} overruns the message")
+    key = buf[p:q]
+    t, val, val2, n = _unpack_doubles(buf, q)
+    p = q + 28
     if n < 0 or p + n != stop:
         raise ProtocolError(
             f"message at offset {pos}: length field says {length} bytes but its fields take {p + max(n, 0) - pos}"
         )
-    sval = bytes(buf[p:stop])
-    return MoosMessage(msg_type, data_type, msg_id, src, aux, com, key, t, val, val2, sval), stop
+    return MoosMessage(msg_type, data_type, msg_id, src, aux, com, key, t, val, val2, buf[p:stop]), stop
 
 
-def decode_packet_body(buf: bytes | bytearray | memoryview, pos: int, total: int) -> list[MoosMessage]:
-    """Parse the messages of a packet whose header starts at ``pos`` and which is ``total`` bytes long."""
+def decode_packet_body(buf: bytes, pos: int, total: int) -> list[MoosMessage]:
+    """Parse the messages of a packet whose header starts at ``pos`` of ``buf`` and is ``total`` bytes long."""
     end = pos + total
     if total < PACKET_HEADER_SIZE or end > len(buf):
         raise ProtocolError(f"packet of {total} bytes does not fit the {len(buf) - pos} bytes given")
@@ -141,6 +145,7 @@ def decode_packet_body(buf: bytes | bytearray | memoryview, pos: int, total: int
 
 def decode_packet(data: bytes | bytearray | memoryview) -> list[MoosMessage]:
     """Parse exactly one complete packet."""
+    data = bytes(data)
     if len(data) < PACKET_HEADER_SIZE:
         raise ProtocolError(f"packet truncated: {len(data)} bytes, header needs {PACKET_HEADER_SIZE}")
     (total,) = _unpack_i32(data, 0)
@@ -170,24 +175,36 @@ class PacketReader:
         """Add bytes; return the list of complete packets now available, each a list of messages."""
         buf = self._buf
         buf += data
-        packets = []
-        pos = 0
         size = len(buf)
+        # Find where the last complete packet ends, then decode from one immutable copy of that region.
+        end = 0
         try:
-            while size - pos >= 4:
-                (total,) = _unpack_i32(buf, pos)
+            while size - end >= 4:
+                (total,) = _unpack_i32(buf, end)
                 if total < PACKET_HEADER_SIZE or total > self._max:
                     raise ProtocolError(
                         f"packet header claims {total} bytes (allowed {PACKET_HEADER_SIZE}..{self._max})"
                     )
-                if size - pos < total:
+                if size - end < total:
                     break
-                packets.append(decode_packet_body(buf, pos, total))
+                end += total
+        except ProtocolError as exc:
+            exc.packets = self._decode_region(end) if end else []
+            raise
+        return self._decode_region(end) if end else []
+
+    def _decode_region(self, end: int) -> list[list[MoosMessage]]:
+        """Decode the whole packets in ``_buf[:end]`` and drop them from the buffer."""
+        region = bytes(self._buf[:end])
+        del self._buf[:end]
+        packets = []
+        pos = 0
+        try:
+            while pos < end:
+                (total,) = _unpack_i32(region, pos)
+                packets.append(decode_packet_body(region, pos, total))
                 pos += total
         except ProtocolError as exc:
-            exc.packets = packets  # the whole packets that came before the bad one, still valid
+            exc.packets = packets
             raise
-        finally:
-            if pos:
-                del buf[:pos]
         return packets
