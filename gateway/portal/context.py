@@ -13,6 +13,7 @@ import threading
 import weakref
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import Any
 
 import zmq
 
@@ -58,6 +59,7 @@ class ProcessContext:
         self._hold_released = threading.Event()
         self._primary_claimed = False
         self._mailboxes: weakref.WeakSet[Mailbox] = weakref.WeakSet()
+        self._closables: weakref.WeakSet[Any] = weakref.WeakSet()
         self._lock = threading.Lock()
         self._zmq: zmq.Context | None = None
         self._closed = False
@@ -77,6 +79,11 @@ class ProcessContext:
                 return False
             self._primary_claimed = True
             return True
+
+    def register_closable(self, thing: Any) -> None:
+        """Track per-thread transports so ``close()`` can release those whose owner never closed them (e.g. a
+        thread constructor that raised after connecting)."""
+        self._closables.add(thing)
 
     def register_mailbox(self, mailbox: Mailbox) -> None:
         """Wake ``mailbox`` when the hold is released (so its buffered publications flush)."""
@@ -98,14 +105,21 @@ class ProcessContext:
         return self._hold_released.wait(timeout)
 
     def close(self) -> None:
-        """Terminate the ZeroMQ context (sockets must be closed first); idempotent."""
+        """Close transports left open, then terminate the ZeroMQ context; idempotent.
+
+        Call it after every thread using the context has finished (their sockets are closed here otherwise).
+        """
         with self._lock:
             if self._closed:
                 return
             self._closed = True
             zctx, self._zmq = self._zmq, None
+        for leftover in list(self._closables):
+            if not getattr(leftover, "closed", True):
+                log.debug("closing transports of %s left open by their thread", getattr(leftover, "thread_name", "?"))
+                leftover.close()
         if zctx is not None:
-            zctx.term()
+            zctx.destroy()  # closes any socket still open instead of blocking forever in term()
 
     def __enter__(self) -> ProcessContext:
         return self

@@ -31,6 +31,11 @@ class ThreadTransports:
         )
         self._interprocess: InterProcessPortal | None = None
         self._closed = False
+        context.register_closable(self)
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
 
     def interthread(self) -> InterThreadTransporter:
         return self._interthread

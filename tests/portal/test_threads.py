@@ -240,3 +240,31 @@ def test_example_config_of_an_app() -> None:
     text = "\n".join(out.lines)
     assert "interprocess {" in text and "platform: \"default_goby_platform\"" in text
     assert "role: \"echo\"" in text and "warp_factor: 1" in text
+
+
+class FailsAfterConnecting(SingleThreadApplication):
+    def __init__(self, cfg: SampleAppConfig) -> None:
+        super().__init__(cfg)  # connects to the broker
+        raise RuntimeError("configuration problem found late")
+
+
+class ThreadFailsAfterConnecting(SimpleThread):
+    def __init__(self, cfg: SampleAppConfig) -> None:
+        super().__init__(cfg)
+        self.interprocess().subscribe("x", Sample, lambda m: None)
+        raise RuntimeError("late failure")
+
+
+class LaunchesFailingThread(MultiThreadApplication):
+    def __init__(self, cfg: SampleAppConfig) -> None:
+        super().__init__(cfg)
+        self.launch_thread(ThreadFailsAfterConnecting)
+
+
+@pytest.mark.parametrize("app_class", [FailsAfterConnecting, LaunchesFailingThread])
+def test_constructor_failing_after_connecting_does_not_hang_shutdown(broker: BrokerProcess, app_class: type) -> None:
+    cfg = SampleAppConfig()
+    cfg.interprocess.CopyFrom(broker.interprocess_config())
+    with pytest.raises((RuntimeError, ThreadError), match="late"):
+        with running_app(app_class, cfg):
+            pass
