@@ -63,17 +63,17 @@ class FrontSeatInterface(MultiThreadApplication):
 
     def __init__(self, cfg: app_pb.FrontSeatInterfaceConfig, driver_factory: DriverFactory) -> None:
         super().__init__(cfg, LOOP_FREQUENCY_HZ)
-        self._driver: FrontSeatDriver = driver_factory(driver_config(cfg))
+        self._next_status: float | None = None
+        self._last_failure = ""
+        self._last_helm_report: float | None = None
         try:
+            self._driver: FrontSeatDriver = driver_factory(driver_config(cfg))
             self._connect_driver()
             self._subscribe()
             self._launch_helm_interface()
         except BaseException:
-            self._driver.close()
+            self.close()  # nobody else will: the caller never gets the object
             raise
-        self._next_status: float | None = None
-        self._last_failure = ""
-        self._last_helm_report: float | None = None
 
     @property
     def driver(self) -> FrontSeatDriver:
@@ -194,8 +194,11 @@ class FrontSeatInterface(MultiThreadApplication):
         self.interprocess().publish(groups.status, status)
 
     def close(self) -> None:
+        """Join the helm thread, close the portal, then the driver; idempotent."""
         super().close()
-        self._driver.close()
+        driver = getattr(self, "_driver", None)  # absent if the driver factory raised
+        if driver is not None:
+            driver.close()
 
 
 def example_config(driver_module: object | None = None) -> str:

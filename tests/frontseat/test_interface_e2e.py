@@ -244,3 +244,21 @@ def test_example_config_includes_the_driver_extension_and_parses(
     cfg = text_format.Parse(text, app_pb.FrontSeatInterfaceConfig())
     assert cfg.frontseat_cfg.require_helm and cfg.frontseat_cfg.status_period == 5
     assert os.environ["FRONTSEAT_DRIVER_LIBRARY"].endswith(".so.30")
+
+
+def test_a_driver_factory_that_raises_exits_1_promptly(tmp_path: Path) -> None:
+    driver = tmp_path / "failing_driver.py"
+    driver.write_text("def frontseat_driver_load(cfg):\n    raise RuntimeError('no vehicle attached')\n")
+    with broker_process(tmp_path, platform="usv") as broker:
+        cfg = tmp_path / "fs.pb.cfg"
+        cfg.write_text("frontseat_cfg { require_helm: false }\n")  # this driver has no config extension
+        env = broker.env()
+        env["FRONTSEAT_DRIVER_LIBRARY"] = str(driver)
+        iface = AppProcess([sys.executable, "-m", "frontseat.interface_app", str(cfg)], env=env,
+                           log_path=tmp_path / "iface.log")
+        try:
+            code = iface.wait(60)
+        finally:
+            iface.stop()
+        assert code == 1
+        assert "no vehicle attached" in iface.stderr_text()

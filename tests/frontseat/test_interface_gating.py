@@ -163,3 +163,29 @@ def test_gating_status_period_publications_datum_and_helm_expiry(tmp_path: Path)
             ScriptedDriverDouble.clock.t += HELM_TIMEOUT + 1
             wait_until(lambda: driver.state() == fs.INTERFACE_HELM_ERROR, what="HELM_ERROR")
             assert driver.last_helm_error() == fs.ERROR_HELM_NOT_RUNNING
+
+
+def test_moos_helm_block_without_the_translator_fails_clearly(tmp_path: Path, monkeypatch) -> None:
+    import sys
+
+    import pytest
+
+    from frontseat.errors import FrontSeatException
+    from frontseat.protobuf import moos_helm_frontseat_interface_config_pb2 as helm_pb
+
+    monkeypatch.setitem(sys.modules, "translators.frontseat_translation", None)  # import now raises ImportError
+    built: list[ScriptedDriverDouble] = []
+
+    def factory(cfg: config_pb.Config) -> ScriptedDriverDouble:
+        built.append(ScriptedDriverDouble(cfg))
+        return built[-1]
+
+    with broker_process(tmp_path, platform="auv") as broker:
+        cfg = app_pb.FrontSeatInterfaceConfig()
+        cfg.interprocess.CopyFrom(broker.interprocess_config())
+        cfg.frontseat_cfg.SetInParent()
+        cfg.Extensions[helm_pb.moos_helm].port = 9000
+        with pytest.raises(FrontSeatException, match="moos_helm.*cannot be imported"):
+            with running_app(partial(FrontSeatInterface, driver_factory=factory), cfg):
+                pass
+    assert len(built) == 1
