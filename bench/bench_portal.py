@@ -121,6 +121,31 @@ class Bench:
         return received / elapsed, n - received, publish_rate
 
 
+def call_soon_latency(n: int) -> tuple[float, float]:
+    """call_soon from this thread to a SimpleThread blocked in its poll: (median, p99) µs until fn runs there."""
+    import threading
+
+    from gateway.portal import MultiThreadApplication, SimpleThread
+    from gateway.portal.testing import running_app
+    from gateway.protobuf.app_config_pb2 import AppConfig
+
+    class Idle(SimpleThread):
+        pass
+
+    samples: list[float] = []
+    with running_app(MultiThreadApplication, AppConfig(name="bench_call_soon")) as app:
+        worker = app.launch_thread(Idle, None)
+        done = threading.Event()
+        for _ in range(n):
+            done.clear()
+            start = time.perf_counter()
+            worker.call_soon(lambda start=start: (samples.append(time.perf_counter() - start), done.set()))
+            done.wait(5)
+            time.sleep(0.0005)  # let the worker block in its poll again
+    samples.sort()
+    return statistics.median(samples) * 1e6, samples[int(len(samples) * 0.99) - 1] * 1e6
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--child", help=argparse.SUPPRESS)
@@ -151,6 +176,9 @@ def main(argv: list[str] | None = None) -> int:
             _, lost, published = bench.throughput(n_small, 0, None)
             rows.append(("blast small, no window", f"{published:,.0f} msg/s published", f"lost {lost}",
                          f"n={n_small}; past the HWM (1000+1000) the broker drops for the slow subscriber"))
+            med, p99 = call_soon_latency(n_lat // 2)
+            rows.append(("call_soon wake-up (same process)", f"median {med:.0f} µs", f"p99 {p99:.0f} µs",
+                         f"n={n_lat // 2}"))
             bench.control("stop")
             client.poll(0.2)
             sub.wait(10)
