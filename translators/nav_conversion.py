@@ -75,6 +75,16 @@ def vehicle_type_name(status: NodeStatus) -> str:
     return VehicleType.Name(status.type)
 
 
+def normalized_heading(degrees: float) -> float:
+    """``degrees`` in [0, 360): a tiny negative angle must not round up to 360 once shifted."""
+    heading = math.fmod(degrees, 360.0)
+    if heading < 0.0:
+        heading += 360.0
+        if heading >= 360.0:
+            heading = 0.0
+    return heading + 0.0  # turns -0.0 into 0.0
+
+
 def node_report(status: NodeStatus, geodesy: UTMGeodesy | None = None, name: str | None = None) -> str:
     """A NODE_REPORT line in the Goby3 course's format, which pHelmIvP's contact parser accepts.
 
@@ -85,10 +95,7 @@ def node_report(status: NodeStatus, geodesy: UTMGeodesy | None = None, name: str
     """
     x, y = local_xy(status, geodesy)
     vehicle_name = name or status.name or vehicle_type_name(status)
-    heading = math.fmod(status.pose.heading, 360.0)
-    if heading < 0:
-        heading += 360.0
-    heading += 0.0  # turns -0.0 into 0.0
+    heading = normalized_heading(status.pose.heading)
     fields = [
         ("NAME", vehicle_name),
         ("TYPE", vehicle_type_name(status)),

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus, Source
 from gateway.geodesy import UTMGeodesy
@@ -127,3 +129,23 @@ def test_node_report_name_falls_back_to_the_type_and_can_be_overridden():
     status.type = 10  # AUV
     assert node_report(status).startswith("NAME=AUV,TYPE=AUV,")
     assert node_report(status, name="AUV_0").startswith("NAME=AUV_0,TYPE=AUV,")
+
+
+@settings(max_examples=60, deadline=None)
+@given(x=st.floats(-20000, 20000), y=st.floats(-20000, 20000))
+def test_nav_x_y_invert_the_datums_grid(x, y):
+    """Any point placed on the datum's grid comes back as the same NAV_X/NAV_Y (to a millimetre)."""
+    geodesy = UTMGeodesy(*ORIGIN)
+    lat, lon = geodesy.to_geo(x, y)
+    posts = dict(nav_posts(make_status(lat, lon), geodesy))
+    assert posts["NAV_X"] == pytest.approx(x, abs=0.001)
+    assert posts["NAV_Y"] == pytest.approx(y, abs=0.001)
+
+
+@settings(max_examples=60, deadline=None)
+@given(heading=st.floats(-1000, 1000))
+def test_node_report_heading_is_always_in_0_360(heading):
+    status = make_status(43.8, -70.3, pose__heading=heading)
+    hdg = float(dict(item.split("=", 1) for item in node_report(status).split(","))["HDG"])
+    assert 0.0 <= hdg < 360.0
+    assert math.isclose(math.cos(math.radians(hdg)), math.cos(math.radians(heading)), abs_tol=1e-9)

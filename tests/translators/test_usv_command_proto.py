@@ -8,6 +8,8 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from gateway.protobuf.include.dccl import option_extensions_pb2 as dccl_options
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
@@ -125,3 +127,17 @@ def test_the_course_proto_compiles_unchanged_with_protoc(tmp_path, source):
     ours = descriptor_pb2.DescriptorProto()
     USVCommand.DESCRIPTOR.CopyToProto(ours)
     assert compiled.SerializeToString(deterministic=True) == ours.SerializeToString(deterministic=True)
+
+
+@settings(max_examples=200, deadline=None)
+@given(sides=st.integers(-50, 50), radius=st.integers(-5000, 5000))
+def test_a_checked_command_is_always_inside_the_bounds_or_refused(sides, radius):
+    try:
+        checked = check_dccl_bounds(polygon(sides, radius))
+    except DcclBoundsError as error:
+        assert "outside its DCCL bounds" in str(error)
+        assert not (3 <= sides <= 10) or not (95 <= radius < 2005)
+    else:
+        assert 3 <= checked.polygon_sides <= 10 and checked.polygon_sides == sides
+        assert 100 <= checked.polygon_radius <= 2000 and checked.polygon_radius % 10 == 0
+        assert abs(checked.polygon_radius - radius) <= 5
