@@ -16,7 +16,7 @@ import pytest
 from frontseat import groups
 from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_pb2 as fs
-from frontseat.testing import basic_simulator_frontseat_cfg, running_simulator, start_simulator
+from frontseat.testing import SimulatorProcess, basic_simulator_frontseat_cfg, free_tcp_port, start_simulator
 from gateway.portal.testing import AppProcess, PortalClient, broker_process
 
 WARP = 10
@@ -94,27 +94,34 @@ class ScriptedHelm:
 
 
 def test_standby_listen_command_helm_error_fs_error_and_recovery(tmp_path: Path) -> None:
-    with broker_process(tmp_path, platform="usv") as broker, running_simulator() as sim:
+    port = free_tcp_port()
+    sims: list[SimulatorProcess] = []
+    with broker_process(tmp_path, platform="usv") as broker:
         cfg = write_config(
             tmp_path / "frontseat.pb.cfg",
-            sim.port,
+            port,
             status_period=1,
             helm_running_timeout=HELM_TIMEOUT,
+            frontseat_connected_timeout=100,
             reconnect_interval=0.2,
         )
         iface = start_interface(tmp_path, broker, cfg)
-        restarted = None
         try:
             with PortalClient(broker.interprocess_config(), name="scripted_helm") as client:
                 helm = ScriptedHelm(client)
                 assert client.wait_subscribed()
-                # STANDBY first (the simulator link is not up at the very first tick or no NAV yet), then LISTEN
-                helm.until(lambda: helm.status, what="the first status")
+                # no simulator yet: STANDBY, waiting for the frontseat (within frontseat_connected_timeout)
+                standby = helm.until_state(fs.INTERFACE_STANDBY)
+                assert standby.frontseat_state == fs.FRONTSEAT_NOT_CONNECTED
+                assert not standby.HasField("frontseat_error") and not standby.HasField("helm_error")
+                assert helm.out_lines() == []
+
+                # the simulator comes up: START, CTRL,STATE:PAYLOAD and NAV take the interface to LISTEN
+                sims.append(start_simulator(port))
                 listen = helm.until_state(fs.INTERFACE_LISTEN)
                 assert listen.frontseat_state == fs.FRONTSEAT_ACCEPTING_COMMANDS
                 assert listen.helm_state == fs.HELM_NOT_RUNNING
-                assert helm.status[0].state in (fs.INTERFACE_STANDBY, fs.INTERFACE_LISTEN)
-                assert any(line.startswith("START,LAT:41.5923,LON:-70.7113") for line in helm.out_lines())
+                assert helm.out_lines()[0].startswith("START,LAT:41.5923,LON:-70.7113")
                 assert helm.out_lines()[0].endswith(f"WARP:{WARP}")
 
                 # gating in LISTEN: a desired course is not forwarded, a raw send request is
@@ -131,7 +138,7 @@ def test_standby_listen_command_helm_error_fs_error_and_recovery(tmp_path: Path)
                 helm.until(lambda: "CMD,HEADING:90,SPEED:2,DEPTH:0" in helm.out_lines(), what="CMD on raw_out")
                 helm.until(lambda: "CMD,RESULT:OK" in [r.raw.decode() for r in helm.raw_in], what="CMD,RESULT:OK")
 
-                # NAV arrives as node_status (after data_from_frontseat) and shows the vehicle obeying
+                # NAV arrives as node_status (and data_from_frontseat) and shows the vehicle obeying
                 helm.until(lambda: helm.node_status and helm.node_status[-1].pose.heading > 45, what="turning NAV")
                 nav = helm.node_status[-1]
                 assert (nav.name, nav.type) == ("usv", data_pb.USV)
@@ -159,17 +166,17 @@ def test_standby_listen_command_helm_error_fs_error_and_recovery(tmp_path: Path)
                 helm.until_state(fs.INTERFACE_COMMAND)
 
                 # the simulator dies: FS_ERROR(NOT_CONNECTED)
-                sim.stop(kill=True)
+                sims[0].stop(kill=True)
                 fs_error = helm.until_state(fs.INTERFACE_FS_ERROR)
                 assert fs_error.frontseat_error == fs.ERROR_FRONTSEAT_NOT_CONNECTED
                 assert fs_error.frontseat_state == fs.FRONTSEAT_NOT_CONNECTED
                 starts = sum(line.startswith("START") for line in helm.out_lines())
 
-                # ... and comes back on the same port: START again, then COMMAND
+                # ... and comes back on the same port: START again, then STANDBY, LISTEN, COMMAND
                 deadline = time.monotonic() + 30
-                while restarted is None:
+                while len(sims) < 2:
                     try:
-                        restarted = start_simulator(sim.port)
+                        sims.append(start_simulator(port))
                     except RuntimeError:
                         if time.monotonic() > deadline:
                             raise
@@ -180,15 +187,13 @@ def test_standby_listen_command_helm_error_fs_error_and_recovery(tmp_path: Path)
                 assert fs.INTERFACE_FS_ERROR in states and states[-1] == fs.INTERFACE_COMMAND
         finally:
             code = iface.stop()
-            if restarted is not None:
-                restarted.stop()
+            for sim in sims:
+                sim.stop()
         assert code == 0, iface.stderr_text()[-3000:]
 
 
 def test_exit_on_error_quits_with_code_zero(tmp_path: Path) -> None:
     with broker_process(tmp_path, platform="usv") as broker:
-        from frontseat.testing import free_tcp_port
-
         cfg = write_config(tmp_path / "fs.pb.cfg", free_tcp_port(), helm_running_timeout=2,
                            frontseat_connected_timeout=2)
         cfg.write_text(cfg.read_text().replace("frontseat_cfg {", "frontseat_cfg {\n  exit_on_error: true"))
