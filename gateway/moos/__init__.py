@@ -22,16 +22,20 @@ from .factory import make_comms
 from .message import MoosMessage
 
 moos_msg = MoosMessage  # pymoos's name for the message class
+pyMOOSException = MoosError  # pymoos's exception name  # noqa: N816
 
 
-def time(apply_timewarping: bool = True) -> float:
-    """MOOS time (warped unix time plus the skew learned from the DB), as ``pymoos.time()``."""
-    return DEFAULT_CLOCK.time(apply_timewarping)
+def time(apply_timewarping: bool = True, **kwargs: bool) -> float:
+    """MOOS time (warped unix time plus the skew learned from the DB), as ``pymoos.time()``.
+
+    pymoos spells the keyword ``apply_timewartping``; both spellings are accepted.
+    """
+    return DEFAULT_CLOCK.time(kwargs.get("apply_timewartping", apply_timewarping))
 
 
-def local_time(apply_timewarping: bool = True) -> float:
-    """Warped unix time without skew, as ``pymoos.local_time()``."""
-    return DEFAULT_CLOCK.local_time(apply_timewarping)
+def local_time(apply_timewarping: bool = True, **kwargs: bool) -> float:
+    """Warped unix time without skew, as ``pymoos.local_time()`` (either keyword spelling)."""
+    return DEFAULT_CLOCK.local_time(kwargs.get("apply_timewartping", apply_timewarping))
 
 
 def set_moos_timewarp(warp: float) -> None:
@@ -66,6 +70,7 @@ __all__ = [
     "local_time",
     "make_comms",
     "moos_msg",
+    "pyMOOSException",
     "set_moos_timewarp",
     "time",
 ]
