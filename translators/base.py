@@ -96,5 +96,3 @@ class Translator(SimpleThread):
 
     def __repr__(self) -> str:
         return f"<{type(self).__qualname__} {self._name}>"
-
-
