@@ -42,6 +42,7 @@ class Waker:
 
 def connect(kind: str, port: int, name: str, registrations: list[str]) -> tuple[object, Waker]:
     comms = make_comms(kind)
+    comms.set_quiet(True)  # the C++ client prints connection banners on stdout otherwise
     waker = Waker()
     comms.set_on_connect_callback(lambda: all(comms.register(v, 0) for v in registrations))
     comms.set_on_mail_callback(waker)
@@ -104,9 +105,11 @@ def child(role: str, client: str, port: int, name: str, var: str = "", count: in
            "--name", name, "--var", var, "--count", str(count), "--seconds", str(seconds)]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=HERE)
     try:
-        line = proc.stdout.readline()  # type: ignore[union-attr]
-        if line.strip() != "ready":
-            raise RuntimeError(f"{role} worker failed to start: {line!r}")
+        for line in proc.stdout:  # type: ignore[union-attr]  # skip anything a C++ client prints first
+            if line.strip() == "ready":
+                break
+        else:
+            raise RuntimeError(f"{role} worker exited before it was ready ({proc.wait()})")
         yield proc
     finally:
         if proc.poll() is None:
@@ -119,7 +122,7 @@ def child(role: str, client: str, port: int, name: str, var: str = "", count: in
 
 def sink_result(proc: subprocess.Popen[str]) -> dict[str, object]:
     out, _ = proc.communicate(timeout=180)
-    return json.loads(out.strip().splitlines()[-1])
+    return json.loads([line for line in out.splitlines() if line.startswith("{")][-1])
 
 
 # ---- measurements ----------------------------------------------------------------------------------------
@@ -285,6 +288,7 @@ def main(argv: list[str] | None = None) -> int:
     for db_kind, client_kind in combos:
         print(f"running: DB={db_kind} client={client_kind} ...", flush=True)
         rows.append(run_suite(db_kind, client_kind, args.quick))
+        print_table(rows[-1:])
     print()
     print_table(rows)
     return 0

@@ -275,3 +275,19 @@ def test_time_warp_scales_timestamps(db_port: int) -> None:
         assert msg.time() == pytest.approx(time.time() * 10.0, rel=1e-6)
     finally:
         client.close()
+
+
+def test_idle_async_client_stays_alive_on_timing_messages() -> None:
+    """The timing message goes out at least once a second, so a DB with a short timeout keeps an idle client."""
+    from gateway.moos.testing import running_moosdb
+
+    with running_moosdb(client_timeout=1.5) as db, connected_comms(db.port, "idler", ["DB_QOS"]) as idler:
+        deadline = time.monotonic() + 3.5
+        while time.monotonic() < deadline:
+            assert idler.is_connected() and "idler" in db.client_names()
+            time.sleep(0.1)
+        assert not db.dropped
+        with connected_comms(db.port, "poker") as poker:
+            qos = collect_mail(idler, ["DB_QOS"], until=lambda ms: bool(poker.notify("P", 1.0)) and bool(ms),
+                               timeout=10)
+        assert "idler=" in qos[-1].string()
