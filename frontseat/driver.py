@@ -19,6 +19,7 @@ import logging
 import math
 from typing import Protocol
 
+from frontseat import seawater
 from frontseat.errors import ConfigError, FrontSeatErrorException, HelmErrorException
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_data_pb2 as data_pb
@@ -176,8 +177,14 @@ class FrontSeatDriver(abc.ABC):
         """The UTM grid used by :meth:`compute_missing`."""
         return self._geodesy
 
-    def compute_missing(self, node_status: data_pb.NodeStatus) -> None:
-        """Fill name, type, time, and whichever of the global/local fix is missing from the other."""
+    def compute_missing(self, message: data_pb.NodeStatus | data_pb.CTDSample) -> None:
+        """Fill what can be derived in a NodeStatus (name, type, time, the missing fix) or a CTDSample."""
+        if isinstance(message, data_pb.CTDSample):
+            _compute_missing_ctd(message)
+        else:
+            self._compute_missing_node_status(message)
+
+    def _compute_missing_node_status(self, node_status: data_pb.NodeStatus) -> None:
         if not node_status.HasField("name"):
             node_status.name = self._cfg.name
         if not node_status.HasField("type"):
@@ -264,6 +271,26 @@ class FrontSeatDriver(abc.ABC):
             raise FrontSeatErrorException(fs_pb.ERROR_FRONTSEAT_NOT_CONNECTED)
         if not self.frontseat_providing_data() and self._state != fs_pb.INTERFACE_STANDBY:
             raise FrontSeatErrorException(fs_pb.ERROR_FRONTSEAT_NOT_PROVIDING_DATA)
+
+
+def _compute_missing_ctd(ctd: data_pb.CTDSample) -> None:
+    """Salinity, depth, sound speed and density from the primary measurements (UNESCO 1983), where unset."""
+    pressure_dbar = ctd.pressure / 1e4  # the proto carries pascals
+    if not ctd.HasField("salinity"):
+        ctd.salinity = seawater.salinity(ctd.conductivity, ctd.temperature, pressure_dbar)
+        ctd.salinity_algorithm = data_pb.CTDSample.UNESCO_44_PREKIN_AND_LEWIS_1980
+    if not ctd.global_fix.HasField("depth"):
+        ctd.global_fix.depth = seawater.depth(pressure_dbar, ctd.global_fix.lat)
+    if not ctd.HasField("sound_speed"):
+        try:
+            ctd.sound_speed = seawater.mackenzie_sound_speed(ctd.temperature, ctd.salinity, ctd.global_fix.depth)
+        except ValueError as exc:
+            log.warning("sound speed not computed: %s", exc)
+            ctd.sound_speed = math.nan
+        ctd.sound_speed_algorithm = data_pb.CTDSample.MACKENZIE_1981
+    if not ctd.HasField("density"):
+        ctd.density = seawater.density(ctd.salinity, ctd.temperature, pressure_dbar)
+        ctd.density_algorithm = data_pb.CTDSample.UNESCO_38_MILLERO_AND_POISSON_1981
 
 
 def _make_geodesy(lat: float, lon: float) -> UTMGeodesy:
