@@ -33,6 +33,9 @@ EVENT_VARS = (
     "LOITER_MODE",
     "WPT_INDEX",
 )
+# Posted every helm iteration; only changes are worth keeping. (Command variables are kept every time:
+# the same command twice is two commands.)
+CHANGES_ONLY = frozenset({"IVPHELM_STATE", "VIEW_POLYGON", "VIEW_SEGLIST", "LOITER_MODE", "WPT_INDEX"})
 
 
 class SimClock:
@@ -61,6 +64,7 @@ class MoosRecorder:
         self.comms = comms(clock=MoosClock(settings.warp))
         self.comms.set_on_connect_callback(self._on_connect)
         self.mail_count = 0
+        self._last: dict[str, str] = {}
 
     def _on_connect(self) -> bool:
         for var in (*NAV_VARS, *EVENT_VARS):
@@ -83,6 +87,9 @@ class MoosRecorder:
                 self.record.add_nav(now, name, msg.double())
             elif name in EVENT_VARS:
                 value = msg.string() if msg.is_string() else f"{msg.double():g}"
+                if name in CHANGES_ONLY and self._last.get(name) == value:
+                    continue
+                self._last[name] = value
                 self.record.add_event(now, "moos", name, value, msg.source())
         self.mail_count += len(messages)
         return len(messages)
@@ -98,6 +105,7 @@ class _PortalListener(SimpleThread):
         super().__init__(cfg)
         self._record = record
         self._clock = clock
+        self._last_state: int | None = None
         self.interprocess().subscribe(frontseat_groups.status, InterfaceStatus, self._on_status)
         try:
             from translators.usv import groups as usv_groups
@@ -107,7 +115,9 @@ class _PortalListener(SimpleThread):
         self.interprocess().subscribe(usv_groups.usv_command_ack, USVCommandAck, self._on_ack)
 
     def _on_status(self, status: InterfaceStatus) -> None:
-        if status.HasField("state"):
+        """Keep each change of the interface's state. Runs on the listener's thread."""
+        if status.HasField("state") and status.state != self._last_state:
+            self._last_state = status.state
             self._record.add_event(self._clock.now(), "interface", "interface_state", InterfaceState.Name(status.state))
 
     def _on_ack(self, ack: Any) -> None:
