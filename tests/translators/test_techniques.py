@@ -101,6 +101,9 @@ def test_prefixed_variants(report, pb):
         (Technique.PREFIXED_PROTOBUF_NATIVE_ENCODED, binary),
     ]:
         assert techniques.parse(value, pb.BasicNodeReport(), technique) == report
+    # a binary value that reached us as a str (as our MOOS client decodes strings) parses the same
+    as_str = binary.decode("utf-8", "surrogateescape")
+    assert techniques.parse(as_str, pb.BasicNodeReport(), Technique.PREFIXED_PROTOBUF_NATIVE_ENCODED) == report
     # un-prefixed input is still accepted (Goby's backward compatibility)
     assert techniques.parse(R_TEXT, pb.BasicNodeReport(), Technique.PREFIXED_PROTOBUF_TEXT_FORMAT) == report
     # a prefix with no body clears the message

@@ -123,17 +123,22 @@ def parse(
     """Parse a MOOS value into ``msg`` and return it.
 
     The protobuf techniques clear ``msg`` first; key=value and format merge into it (Goby's behaviour).
-    Binary values may be ``bytes`` or a Latin-1 ``str``.  Raises TechniqueError on malformed input.
+    Binary values are ``bytes`` (or a ``str`` as our MOOS client decodes it).  Raises TechniqueError on malformed
+    input.
     """
     technique = Technique(technique)
-    text = value.decode("latin-1" if technique in _BINARY else "utf-8") if isinstance(value, bytes) else value
+    text = _as_text(value, technique)
     if technique in _BASE:
         base = _BASE[technique]
-        return parse_prefixed(text, msg, lambda body, m: parse(body, m, base), technique.proto_name)
+
+        def base_parse(body: str, target: Message) -> Message:
+            return parse(body.encode("latin-1") if base in _BINARY else body, target, base)
+
+        return parse_prefixed(text, msg, base_parse, technique.proto_name)
+    if technique is Technique.PROTOBUF_NATIVE_ENCODED:
+        return from_native(text.encode("latin-1"), msg)
     if technique is Technique.PROTOBUF_TEXT_FORMAT:
         return from_text_format(text, msg)
-    if technique is Technique.PROTOBUF_NATIVE_ENCODED:
-        return from_native(text, msg)
     if technique is Technique.PROTOBUF_NATIVE_HEX:
         return from_native_hex(text, msg)
     if technique is Technique.COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS:
@@ -141,6 +146,16 @@ def parse(
     if format is None:
         raise TechniqueError("TECHNIQUE_FORMAT needs a format string")
     return parse_format(text, msg, format, repeated_delimiter, use_short_enum)
+
+
+def _as_text(value: str | bytes, technique: Technique) -> str:
+    """Binary techniques work on Latin-1 text (one character per byte, so the bytes survive exactly); a ``str``
+    given for them is first turned back into the bytes our MOOS client decoded it from (UTF-8, surrogate escapes).
+    Text techniques decode ``bytes`` the same way the client does."""
+    if technique in _BINARY:
+        raw = value.encode("utf-8", "surrogateescape") if isinstance(value, str) else bytes(value)
+        return raw.decode("latin-1")
+    return value.decode("utf-8", "surrogateescape") if isinstance(value, bytes) else value
 
 
 def dynamic_parse(
@@ -158,7 +173,7 @@ def dynamic_parse(
         raise TechniqueError(
             f"Non-PREFIX techniques are not supported when using dynamic_parse: {technique.proto_name}"
         )
-    text = value.decode("latin-1") if isinstance(value, bytes) else value
+    text = _as_text(value, technique)
     split = split_prefix(text, technique.proto_name)
     if split is None:
         return None

@@ -16,9 +16,9 @@ def to_native(msg: Message) -> bytes:
 def from_native(data: bytes | str, msg: Message) -> Message:
     """Clear ``msg`` and parse the binary encoding into it; returns ``msg``.
 
-    A ``str`` is taken as Latin-1 (one character per byte), the way a MOOS string carries bytes.
+    A ``str`` is turned back into the bytes our MOOS client decoded it from (UTF-8 with surrogate escapes).
     """
-    raw = data.encode("latin-1") if isinstance(data, str) else bytes(data)
+    raw = data.encode("utf-8", "surrogateescape") if isinstance(data, str) else bytes(data)
     try:
         msg.ParseFromString(raw)
     except DecodeError as exc:
