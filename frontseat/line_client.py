@@ -27,11 +27,13 @@ class LineClient:
         *,
         reconnect_interval: float = 1.0,
         max_line: int = 64 * 1024,
+        io_timeout: float = 5.0,
         name: str = "line-client",
     ) -> None:
         self.host, self.port = host, port
         self.reconnect_interval = max(0.01, reconnect_interval)
         self.max_line = max_line
+        self.io_timeout = io_timeout  # bounds how long write_line can block the owner's thread
         self._name = name
         self._lines: deque[str] = deque()
         self._lock = threading.Lock()  # guards _sock and writes
@@ -66,10 +68,7 @@ class LineClient:
         with self._lock:
             sock = self._sock
         if sock is not None:
-            try:
-                sock.shutdown(socket.SHUT_RDWR)
-            except OSError:
-                pass
+            _shutdown(sock)
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=10)
 
@@ -95,6 +94,11 @@ class LineClient:
             try:
                 sock.sendall(line.encode() + DELIMITER)
                 return True
+            except TimeoutError:
+                # the peer stopped reading: a partial line may be on the wire, so start over on a new connection
+                log.error("write to %s timed out after %.0f s; reconnecting", self.address, self.io_timeout)
+                _shutdown(sock)
+                return False
             except OSError as exc:
                 log.warning("write to %s failed: %s", self.address, exc)
                 return False
@@ -112,7 +116,7 @@ class LineClient:
                 self._closing.wait(self.reconnect_interval)
                 continue
             failures = 0
-            sock.settimeout(None)
+            sock.settimeout(self.io_timeout)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             with self._lock:
                 if self._closing.is_set():
@@ -135,6 +139,8 @@ class LineClient:
         while True:
             try:
                 data = sock.recv(65536)
+            except TimeoutError:
+                continue  # quiet peer; the timeout exists for writes
             except OSError:
                 return
             if not data:
@@ -152,3 +158,11 @@ class LineClient:
                     log.error("%s sent a line longer than %d bytes; discarding it", self.address, self.max_line)
                 discarding = True
                 del buffer[:-1]
+
+
+def _shutdown(sock: socket.socket) -> None:
+    """Wake the reader thread out of ``recv`` (it then closes and reconnects)."""
+    try:
+        sock.shutdown(socket.SHUT_RDWR)
+    except OSError:
+        pass

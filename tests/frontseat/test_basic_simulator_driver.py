@@ -189,3 +189,19 @@ def test_ctrl_states_garbage_and_missing_nav_values() -> None:
             assert peer.received.startswith(b"START,LAT:41.5923")
     finally:
         peer.close()
+
+
+def test_line_client_write_to_a_peer_that_never_reads_times_out_and_reconnects() -> None:
+    from frontseat.line_client import LineClient
+
+    listener = socket.create_server(("127.0.0.1", 0))  # accepts (kernel backlog) but never reads
+    try:
+        with LineClient("127.0.0.1", listener.getsockname()[1], io_timeout=0.5, reconnect_interval=0.05) as link:
+            wait_until(lambda: link.connected, what="connection")
+            first = link.connection_id
+            started = time.monotonic()
+            assert link.write_line("X" * (64 * 1024 * 1024)) is False  # far more than the socket buffers hold
+            assert time.monotonic() - started < 10
+            wait_until(lambda: link.connection_id > first and link.connected, what="a fresh connection")
+    finally:
+        listener.close()
