@@ -178,4 +178,4 @@ def dynamic_parse(
     if split is None:
         return None
     msg = new_message(split[0], pool)
-    return parse(text, msg, technique)
+    return parse(value, msg, technique)
