@@ -119,3 +119,27 @@ def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(
     assert max(float(r["x"]) ** 2 + float(r["y"]) ** 2 for r in rows) > 100**2  # it moved out toward the ring
     assert (out_dir / "track.png").stat().st_size > 10_000
     assert (out_dir / "events.csv").exists()
+
+
+def test_demo_names_a_component_that_dies_and_exits_non_zero(tmp_path):
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "launch.usv.demo", "--out", str(tmp_path / "o"), "--duration", "0", "--warp", "20",
+         "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_tcp_port()),
+         "--sim-port", str(free_tcp_port())],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+    out = OutputReader(proc)
+    try:
+        sim_pid = int(out.wait_for(r"^Launched \((\d+)\) usv\.frontseat-sim:").group(1))
+        out.wait_for(r"^t=\s*\d+/?\S* s sim \| interface INTERFACE_COMMAND")
+        os.kill(sim_pid, signal.SIGKILL)
+        text = out.finish()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        out.finish()
+    assert proc.returncode == 1, text
+    assert "process 'usv.frontseat-sim' died (exit status -9)" in text
+    assert "FAILED: process 'usv.frontseat-sim' died" in text  # the summary says so too
+    assert "=== USV mission summary" in text
+    assert (tmp_path / "o" / "track.png").exists()
