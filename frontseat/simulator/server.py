@@ -174,7 +174,8 @@ class SimulatorServer:
         if len(client.inbuf) > MAX_LINE:
             if not client.discarding:
                 log.error(
-                    "client %s sent a line longer than %d bytes; discarding it up to the next \\r\\n",
+                    "client %s sent a line longer than %d bytes (lines must end with \\r\\n); "
+                    "discarding it up to the next \\r\\n",
                     client.peer,
                     MAX_LINE,
                 )
