@@ -97,3 +97,14 @@ def test_goby_broker_example_config_and_debug_cfg_cli() -> None:
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 2
     assert "configuration error" in out.stderr and "--router_threads" in out.stderr
+
+
+def test_goby_broker_reads_goby_interprocess() -> None:
+    import os
+
+    env = {**os.environ, "GOBY_INTERPROCESS": 'platform: "from_env" socket_name: "/tmp/x"'}
+    out = subprocess.run([sys.executable, "-m", "gateway.portal.broker_main", "--app", "debug_cfg: true"],
+                         capture_output=True, text=True, timeout=60, env=env)
+    assert out.returncode == 0, out.stderr
+    cfg = text_format.Parse(out.stdout, GobyDaemonConfig())
+    assert (cfg.interprocess.platform, cfg.interprocess.socket_name) == ("from_env", "/tmp/x")
