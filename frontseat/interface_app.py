@@ -205,19 +205,22 @@ def example_config(driver_module: object | None = None) -> str:
     """A commented example configuration, with the driver's extension block when it declares one."""
     from gateway.portal.config import example_config as message_example
 
+    fields = app_pb.FrontSeatInterfaceConfig.DESCRIPTOR.fields_by_name
+    app_body = message_example(fields["app"].message_type, 1)
+    interprocess_body = message_example(fields["interprocess"].message_type, 1)
+    frontseat_body = message_example(config_pb.Config.DESCRIPTOR, 1)
     extension = getattr(driver_module, "CONFIG_EXTENSION", None)
-    body = message_example(config_pb.Config.DESCRIPTOR, 1)
     if extension is not None:
-        sub = message_example(extension.message_type, 2)
-        body += f"\n  [{extension.full_name}] {{  # the driver's settings\n{sub}\n  }}"
-    helm = message_example(gateway_pb.GobyMOOSGatewayConfig.MOOSConfig.DESCRIPTOR, 1)
-    helm = "\n".join(f"# {line}" for line in helm.splitlines())
+        driver_body = message_example(extension.message_type, 2)
+        frontseat_body += f"\n  [{extension.full_name}] {{  # the driver's settings\n{driver_body}\n  }}"
+    helm_body = message_example(gateway_pb.GobyMOOSGatewayConfig.MOOSConfig.DESCRIPTOR, 1)
+    helm_body = "\n".join(f"# {line}" for line in helm_body.splitlines())
     return (
-        f"app {{\n{message_example(app_pb.FrontSeatInterfaceConfig.DESCRIPTOR.fields_by_name['app'].message_type, 1)}\n}}\n"
-        f"interprocess {{\n{message_example(app_pb.FrontSeatInterfaceConfig.DESCRIPTOR.fields_by_name['interprocess'].message_type, 1)}\n}}\n"
-        f"frontseat_cfg {{  # name and origin are set from interprocess.platform and app.geodesy\n{body}\n}}\n"
-        f"# [goby.moos.protobuf.moos_helm] {{  # run the MOOS helm interface (FrontSeatTranslation) thread\n"
-        f"{helm}\n# }}"
+        f"app {{\n{app_body}\n}}\n"
+        f"interprocess {{\n{interprocess_body}\n}}\n"
+        f"frontseat_cfg {{  # name and origin are set from interprocess.platform and app.geodesy\n{frontseat_body}\n}}\n"
+        "# [goby.moos.protobuf.moos_helm] {  # run the MOOS helm interface (FrontSeatTranslation) thread\n"
+        f"{helm_body}\n# }}"
     )
 
 
