@@ -205,3 +205,18 @@ def test_line_client_write_to_a_peer_that_never_reads_times_out_and_reconnects()
             wait_until(lambda: link.connection_id > first and link.connected, what="a fresh connection")
     finally:
         listener.close()
+
+
+def test_duration_expiry_leads_command_to_listen_then_not_providing_data() -> None:
+    """§6.5 step 10 with real parts: CTRL,STATE:IDLE ends COMMAND; silence then trips the data timeout."""
+    with SimulatorServer() as server:
+        cfg = make_cfg(server.port, warp=10, data_timeout=0.5)
+        cfg.Extensions[sim_pb.basic_simulator_config].start.duration = 5  # 5 s simulated = 0.5 s real at warp 10
+        with BasicSimulatorDriver(cfg, clock=AdjustableClock()) as driver:
+            states: list[int] = []
+            driver.signal_state_change.connect(states.append)
+            driver.set_helm_state(fs.HELM_DRIVE)
+            tick_until(driver, lambda: driver.state() == fs.INTERFACE_FS_ERROR, what="FS_ERROR")
+            assert states == [fs.INTERFACE_LISTEN, fs.INTERFACE_COMMAND, fs.INTERFACE_LISTEN, fs.INTERFACE_FS_ERROR]
+            assert driver.last_frontseat_error() == fs.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
+            assert driver.frontseat_state() == fs.FRONTSEAT_IDLE
