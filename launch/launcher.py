@@ -108,7 +108,6 @@ def main(argv: list[str] | None = None) -> int:
         kill_timeout_s=args.kill_s,
         startup_check_s=args.startup_check,
         base_env=child_environment(),
-        cwd=Path(args.launchfile).resolve().parent,
         parallel_stop=args.parallel,
     )
     print(f"Logs in {log_dir}", flush=True)

@@ -133,7 +133,7 @@ class ProcessGroup:
         name = self._unique_name(entry, env)
         self.log_dir.mkdir(parents=True, exist_ok=True)
         log_path = self.log_dir / f"{name}.log"
-        log_file = open(log_path, "wb")  # noqa: SIM115 - closed when the process is reaped
+        log_file = open(log_path, "wb")  # closed when the process is reaped
         # `exec` makes the program itself the pid we signal; bash cannot exec an assignment prefix.
         script = entry.command if _ASSIGNMENT.match(entry.command) else f"exec {entry.command}"
         try:

@@ -87,6 +87,12 @@ def generate(app: str, settings: UsvSettings) -> str:
         generator = GENERATORS[app]
     except KeyError:
         raise ConfigError(f"App: {app} not defined (known: {', '.join(sorted(GENERATORS))})") from None
+    # The run directory holds the broker's sockets and the .moos file: make sure it exists whichever app comes first.
+    try:
+        settings.run_dir.mkdir(parents=True, exist_ok=True)
+        Path(settings.ipc_base).parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"cannot create the run directory {settings.run_dir}: {exc.strerror or exc}") from exc
     return generator(settings)
 
 

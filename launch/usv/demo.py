@@ -13,6 +13,7 @@ import argparse
 import logging
 import shutil
 import signal
+import socket
 import sys
 import tempfile
 import time
@@ -58,8 +59,6 @@ def _port(requested: int, preferred: int) -> int:
     if requested:
         return requested
     try:
-        import socket
-
         with socket.socket() as sock:
             sock.bind(("127.0.0.1", preferred))
         return preferred

@@ -117,7 +117,7 @@ class UsvMission:
             launch_delay_s=self.launch_delay_s,
             kill_timeout_s=10.0,
             base_env=env,
-            cwd=USV_DIR,
+            cwd=self.settings.run_dir,
             report=self.report,
         )
         self.group.stop_event = self.stop_event

@@ -26,6 +26,7 @@ from frontseat import groups as frontseat_groups
 from frontseat.protobuf.frontseat_pb2 import INTERFACE_COMMAND, InterfaceStatus
 from gateway.portal import SingleThreadApplication, run_application
 from launch.errors import ConfigError
+from launch.usv.settings import DEFAULT_SCHEDULE
 from translators.usv.protobuf.usv_config_pb2 import CommandTool
 
 log = logging.getLogger(__name__)
@@ -142,8 +143,9 @@ def _tool_config_file(cfg: CommandTool) -> Path:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0])
-    parser.add_argument("--schedule", default=os.environ.get("USV_SHORE_SCHEDULE", ""),
-                        help="T:waypoints / T:polygon:SIDES:RADIUS, comma-separated (default $USV_SHORE_SCHEDULE)")
+    parser.add_argument("--schedule", default=os.environ.get("USV_SHORE_SCHEDULE") or DEFAULT_SCHEDULE,
+                        help="T:waypoints / T:polygon:SIDES:RADIUS, comma-separated "
+                        f"(default $USV_SHORE_SCHEDULE or {DEFAULT_SCHEDULE})")
     args, goby_argv = parser.parse_known_args(argv)
     try:
         plan = parse_schedule(args.schedule)
