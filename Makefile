@@ -4,7 +4,7 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 
-.PHONY: demo test bench protos lint clean
+.PHONY: demo test bench protos interfaces lint clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -25,6 +25,10 @@ bench: $(VENV)/.installed
 
 protos: $(VENV)/.installed
 	$(BIN)/python -m gateway.protobuf.generate
+
+interfaces: $(VENV)/.installed
+	$(BIN)/goby-interfaces generate --all
+	$(BIN)/goby-interfaces visualize docs/interfaces/usv_deployment.yml --outdir docs/interfaces --no-disconnected --format svg
 
 lint: $(VENV)/.installed
 	$(BIN)/ruff check .

@@ -16,6 +16,7 @@ import ast
 import importlib
 import inspect
 import logging
+import typing
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -69,23 +70,36 @@ def _layer_of(node: ast.expr, aliases: dict[str, str]) -> str | None:
     return None
 
 
+@dataclass(frozen=True)
+class _Origin:
+    """How a local name got its value: an annotation, or (an element of) a call's result."""
+
+    annotation: ast.expr | None = None
+    call: ast.Call | None = None
+    index: int | None = None  # element of a tuple result
+
+
 class _FunctionTypes:
-    """Types of local names in one function, from constructor calls and annotations."""
+    """Where local names of one function come from: annotations, constructor or function calls."""
 
     def __init__(self, func: ast.FunctionDef | ast.AsyncFunctionDef | None) -> None:
-        self.exprs: dict[str, ast.expr] = {}
+        self.origins: dict[str, _Origin] = {}
         if func is None:
             return
         for arg in [*func.args.posonlyargs, *func.args.args, *func.args.kwonlyargs]:
             if arg.annotation is not None:
-                self.exprs[arg.arg] = arg.annotation
+                self.origins[arg.arg] = _Origin(annotation=arg.annotation)
         for node in ast.walk(func):
             if isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
-                self.exprs[node.target.id] = node.annotation
+                self.origins[node.target.id] = _Origin(annotation=node.annotation)
             elif isinstance(node, ast.Assign) and isinstance(node.value, ast.Call):
                 for target in node.targets:
-                    if isinstance(target, ast.Name) and target.id not in self.exprs:
-                        self.exprs[target.id] = node.value.func
+                    if isinstance(target, ast.Name):
+                        self.origins.setdefault(target.id, _Origin(call=node.value))
+                    elif isinstance(target, ast.Tuple):
+                        for i, element in enumerate(target.elts):
+                            if isinstance(element, ast.Name):
+                                self.origins.setdefault(element.id, _Origin(call=node.value, index=i))
 
 
 class _ModuleAnalyzer(ast.NodeVisitor):
@@ -101,10 +115,36 @@ class _ModuleAnalyzer(ast.NodeVisitor):
     def _where(self, node: ast.AST) -> _Where:
         return _Where(str(self.path), getattr(node, "lineno", 0))
 
+    def _namespace(self) -> dict[str, object]:
+        """The module's globals plus the imports made inside the enclosing function."""
+        namespace = dict(vars(self.module))
+        for func in self.func_stack:
+            for sub in ast.walk(func):
+                if isinstance(sub, ast.ImportFrom) and sub.module and sub.level == 0:
+                    for alias in sub.names:
+                        try:
+                            owner = importlib.import_module(sub.module)
+                            value = getattr(owner, alias.name, None)
+                            if value is None:
+                                value = importlib.import_module(f"{sub.module}.{alias.name}")
+                        except ImportError:
+                            continue
+                        namespace[alias.asname or alias.name] = value
+                elif isinstance(sub, ast.Import):
+                    for alias in sub.names:
+                        try:
+                            imported = importlib.import_module(alias.name)
+                        except ImportError:
+                            continue
+                        namespace[alias.asname or alias.name.split(".")[0]] = (
+                            imported if alias.asname else importlib.import_module(alias.name.split(".")[0])
+                        )
+        return namespace
+
     def _eval(self, expr: ast.expr, node: ast.AST, what: str) -> object:
         try:
             code = compile(ast.Expression(expr), str(self.path), "eval")
-            return eval(code, vars(self.module))  # noqa: S307 - evaluating names/attributes of our own modules
+            return eval(code, self._namespace())  # noqa: S307 - evaluating names/attributes of our own modules
         except Exception as exc:  # any failure means we cannot resolve it statically
             raise AnalysisError(f"{self._where(node)}: cannot resolve the {what} `{ast.unparse(expr)}`: {exc}") from exc
 
@@ -130,11 +170,14 @@ class _ModuleAnalyzer(ast.NodeVisitor):
         if isinstance(expr, ast.Constant) and isinstance(expr.value, str):
             return str
         if isinstance(expr, ast.Call):
-            return self._as_type(self._eval(expr.func, node, "message constructor"), expr, node)
+            return self._call_result_type(expr, None, node)
         types = _FunctionTypes(self.func_stack[-1] if self.func_stack else None)
         if isinstance(expr, ast.Name):
-            if expr.id in types.exprs:
-                return self._as_type(self._eval(types.exprs[expr.id], node, "message type"), expr, node)
+            origin = types.origins.get(expr.id)
+            if origin is not None and origin.annotation is not None:
+                return self._as_type(self._eval(origin.annotation, node, "message type"), expr, node)
+            if origin is not None and origin.call is not None:
+                return self._call_result_type(origin.call, origin.index, node)
             raise AnalysisError(
                 f"{self._where(node)}: cannot tell the type of published `{expr.id}`; build it in the same function "
                 f"(`{expr.id} = Type(...)`) or annotate it (`{expr.id}: Type`)"
@@ -147,6 +190,32 @@ class _ModuleAnalyzer(ast.NodeVisitor):
                     return self._class_for(field.message_type.full_name, owner, node)
             raise AnalysisError(f"{self._where(node)}: `{ast.unparse(expr)}` is not a message field")
         raise AnalysisError(f"{self._where(node)}: cannot tell the type of published `{ast.unparse(expr)}`")
+
+    def _call_result_type(self, call: ast.Call, index: int | None, node: ast.AST) -> type:
+        """The message type a call returns: a constructor, or a function's return annotation.
+
+        A return annotation that is a TypeVar takes the type of the first argument (``def f(m: M) -> M``);
+        ``tuple[A, B]`` results are indexed when the call is unpacked.
+        """
+        callee = self._eval(call.func, node, "callee")
+        if isinstance(callee, type):
+            return self._as_type(callee, call, node)
+        try:
+            hints = typing.get_type_hints(callee)
+        except Exception as exc:
+            raise AnalysisError(f"{self._where(node)}: cannot read the return type of `{ast.unparse(call.func)}`: {exc}") from exc
+        result = hints.get("return")
+        if index is not None and typing.get_origin(result) is tuple:
+            args = typing.get_args(result)
+            result = args[index] if index < len(args) else None
+        if isinstance(result, typing.TypeVar) and call.args:
+            return self._message_type(call.args[0], node)
+        if isinstance(result, type) and (issubclass(result, Message) and result is not Message or result is str):
+            return result
+        raise AnalysisError(
+            f"{self._where(node)}: `{ast.unparse(call.func)}` is not annotated with a specific message return type "
+            f"(got {result!r}); annotate it, or use a TypeVar for 'same type as the argument'"
+        )
 
     def _class_for(self, full_name: str, near: type, node: ast.AST) -> type:
         from google.protobuf import symbol_database
@@ -167,6 +236,11 @@ class _ModuleAnalyzer(ast.NodeVisitor):
         if not text:
             raise AnalysisError(f"{self._where(node)}: empty group `{ast.unparse(expr)}`")
         return text
+
+    def _literal(self, expr: ast.expr | None, default: str, node: ast.AST) -> str:
+        if expr is None:
+            return default
+        return str(self._eval(expr, node, "regular expression"))
 
     @staticmethod
     def _arg(call: ast.Call, index: int, keyword: str) -> ast.expr | None:
@@ -208,7 +282,9 @@ class _ModuleAnalyzer(ast.NodeVisitor):
         thread = self._thread_name()
         self._note_thread(thread)
         if func.attr == "subscribe_regex":
-            self.interface.add(PubSubEntry(layer, thread, ".*", "ALL_SCHEMES", ".*", "subscribes", is_regex=True))
+            group_regex = self._literal(self._arg(node, 1, "group_regex"), ".*", node)
+            type_regex = self._literal(self._arg(node, 2, "type_regex"), ".*", node)
+            self.interface.add(PubSubEntry(layer, thread, group_regex, "ALL_SCHEMES", type_regex, "subscribes", is_regex=True))
             return
         group_expr = self._arg(node, 0, "group")
         if group_expr is None:
@@ -252,7 +328,7 @@ def _is_excluded(module_name: str) -> bool:
     return any(module_name == p or module_name.startswith(p + ".") for p in EXCLUDED_PACKAGES)
 
 
-def analyze_modules(application: str, module_names: list[str], follow_imports: bool = True) -> ApplicationInterface:
+def analyze_modules(application: str, module_names: list[str], follow_imports: bool = False) -> ApplicationInterface:
     """Analyze ``module_names`` and, if asked, the modules they import from their own top-level package.
 
     Following stays inside the application's own package, as goby_clang_tool sees only the target's sources:

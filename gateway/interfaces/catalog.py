@@ -1,6 +1,7 @@
 """The applications we ship, and the modules whose code makes up each one's interface.
 
-A gateway plugin is listed as its own entry whose interface is merged into ``moos-gateway`` in a deployment
+Only the listed modules are analysed (as goby_clang_tool sees only a target's own sources): a plugin that
+imports another plugin's module does not inherit its calls. A gateway plugin is listed as its own entry whose interface is merged into ``moos-gateway`` in a deployment
 (the ``application:`` override of a deployment entry), as Goby lists its plugin libraries.
 """
 
@@ -14,4 +15,6 @@ SHIPPED_APPLICATIONS: dict[str, list[str]] = {
     "moos-gateway-usv-command-plugin": ["translators.command_translation"],
     "moos-gateway-node-report-plugin": ["translators.node_report"],
     "goby-helm-example": ["behaviors.goby_helm_example"],
+    "usv-mission-shore": ["launch.usv.shore"],
+    "usv-mission-recorder": ["launch.usv.recorder"],
 }
