@@ -46,7 +46,7 @@ def test_gateway_process_end_to_end(tmp_path, moosdb_kind, stop_signal):
     with any_moosdb(moosdb_kind, tmp_path) as db, broker_process(tmp_path, platform="gwe2e") as broker:
         gateway = GatewayProcess(tmp_path, [str(plugin)], _gateway_config(broker, db.port), extra_args=["-v"])
         with gateway, PortalClient(broker.interprocess_config(), name="peer") as peer, \
-                connected_comms(db.port, "poster", register=["OUT", "OUT_LOWER", TIME_VAR]) as poster:
+                connected_comms(db.port, "poster", register=["OUT", "OUT_LOWER", TIME_VAR, "DB_CLIENTS"]) as poster:
             from_moos = peer.collect("from_moos", str)
             assert peer.wait_subscribed()
 
@@ -79,7 +79,20 @@ def test_gateway_process_end_to_end(tmp_path, moosdb_kind, stop_signal):
                 else:
                     raise AssertionError("Goby -> MOOS did not resume after the MOOSDB restart")
 
+            def translator_listed(got) -> bool:
+                return any("goby::moos::Translator::" in m.string() for m in got)
+
+            assert translator_listed(collect_mail(poster, ["DB_CLIENTS"], until=translator_listed, timeout=20))
             assert gateway.stop(stop_signal) == 0, gateway.stderr()
+            # the translator's MOOS client closed: the DB no longer lists it (a DB publishes DB_CLIENTS while it
+            # handles traffic, so keep poking it)
+            clients: list = []
+            for _ in range(40):
+                poster.notify("POKE", 1.0)
+                clients += collect_mail(poster, ["DB_CLIENTS"], until=1, timeout=0.5)
+                if clients and not translator_listed(clients[-1:]):
+                    break
+            assert clients and not translator_listed(clients[-1:]), [m.string() for m in clients]
         assert "Traceback" not in gateway.stderr()
 
 
