@@ -18,6 +18,7 @@ import socket
 import statistics
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from collections.abc import Iterator
@@ -103,7 +104,10 @@ def child(role: str, client: str, port: int, name: str, var: str = "", count: in
           seconds: float = 60) -> Iterator[subprocess.Popen[str]]:
     cmd = [sys.executable, "-m", "bench.bench_moos", "--worker", role, "--client", client, "--port", str(port),
            "--name", name, "--var", var, "--count", str(count), "--seconds", str(seconds)]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=HERE)
+    log = tempfile.NamedTemporaryFile(prefix=f"bench_moos_{name}_", suffix=".log", delete=False)
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=log, text=True, cwd=HERE)
+    proc.log_path = log.name  # type: ignore[attr-defined]
+    log.close()
     try:
         for line in proc.stdout:  # type: ignore[union-attr]  # skip anything a C++ client prints first
             if line.strip() == "ready":
@@ -121,8 +125,14 @@ def child(role: str, client: str, port: int, name: str, var: str = "", count: in
 
 
 def sink_result(proc: subprocess.Popen[str]) -> dict[str, object]:
-    out, _ = proc.communicate(timeout=180)
-    return json.loads([line for line in out.splitlines() if line.startswith("{")][-1])
+    out = proc.stdout.read()  # type: ignore[union-attr]  # same buffered reader that saw "ready"
+    proc.wait(60)
+    lines = [line for line in out.splitlines() if line.startswith("{")]
+    if not lines:
+        tail = Path(proc.log_path).read_text(errors="replace")[-300:]  # type: ignore[attr-defined]
+        print(f"  a sink failed (exit {proc.returncode}): {tail!r}", file=sys.stderr)
+        return {"received": 0, "in_order": False, "first": 0.0, "last": 0.0}
+    return json.loads(lines[-1])
 
 
 # ---- measurements ----------------------------------------------------------------------------------------

@@ -135,9 +135,29 @@ def decode_packet_body(buf: bytes, pos: int, total: int) -> list[MoosMessage]:
     p = pos + PACKET_HEADER_SIZE
     messages = []
     append = messages.append
+    # Fast path: messages in a packet usually share their src/aux/community/key lengths, so the previous
+    # message's layout is tried first as one compiled struct. It is only accepted when every length field it
+    # read equals the length it assumed, which makes it exactly as strict as decode_message.
+    layout: Struct | None = None
+    lengths = (-1, -1, -1, -1)
     for _ in range(count):
+        if layout is not None and p + layout.size <= end:
+            f = layout.unpack_from(buf, p)
+            n_sval = f[15]
+            stop = p + f[0]
+            if (
+                (f[4], f[6], f[8], f[10]) == lengths
+                and n_sval >= 0
+                and f[0] == layout.size + n_sval
+                and stop <= end
+            ):
+                append(MoosMessage(f[2], f[3], f[1], f[5], f[7], f[9], f[11], f[12], f[13], f[14], buf[stop - n_sval : stop]))
+                p = stop
+                continue
         msg, p = decode_message(buf, p, end)
         append(msg)
+        lengths = (len(msg.raw_src), len(msg.raw_aux), len(msg.raw_community), len(msg.raw_key))
+        layout = _head_structs.get(lengths) or _head_struct(*lengths)
     if p != end:
         raise ProtocolError(f"packet of {total} bytes has {end - p} stray bytes after its {count} messages")
     return messages
