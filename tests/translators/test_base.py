@@ -238,3 +238,20 @@ def test_notify_protobuf_uses_the_configured_technique():
 
     with pytest.raises(TechniqueError, match="Non-PROTOBUF"):
         iface.notify_protobuf("APP", AppConfig(), Technique.FORMAT)
+
+
+class PymoosTranslator(Translator):
+    def __init__(self, cfg) -> None:
+        super().__init__(cfg, comms_kind="pymoos")
+
+
+def test_asking_for_the_real_pymoos_when_missing_is_a_clear_error(infrastructure):
+    from gateway.moos.factory import pymoos_available
+    from gateway.moos_gateway import PluginLoadError
+
+    if pymoos_available():
+        pytest.skip("the real pymoos is installed here")
+    db, broker = infrastructure
+    with pytest.raises(PluginLoadError, match="the real pymoos was requested but cannot be imported"):
+        with hosted_translators(gateway_config(db.port, broker.interprocess_config()), PymoosTranslator):
+            pass
