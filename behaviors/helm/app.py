@@ -99,7 +99,11 @@ class HelmApp:
             self._handle_mail()
             now_real = self.clock.time(apply_warp=False)
             if now_real >= next_tick:
-                self._publish(self.helm.iterate(self.clock.time()))
+                try:
+                    self._publish(self.helm.iterate(self.clock.time()))
+                except Exception:  # a bug in one behaviour must not silently stop the helm thread
+                    log.exception("helm iteration failed")
+                    self.comms.notify("BHV_ERROR", "ivp-helm iteration failed (see the helm's log)")
                 next_tick = max(next_tick + period, now_real)
 
     def _handle_mail(self) -> None:

@@ -125,3 +125,14 @@ def test_alias_names_the_app_and_falls_back_to_the_phelmivp_block(tmp_path: Path
             assert app.state == "PARK"
             assert obs.wait(lambda: obs.values("IVPHELM_STATE"))
             assert {src for _, name, _, src in obs.mail if name == "IVPHELM_STATE"} == {"pHelmIvP_backup"}
+
+
+def test_console_script_reports_an_unreadable_mission(tmp_path: Path) -> None:
+    import subprocess
+
+    from .moos_harness import IVP_HELM
+
+    result = subprocess.run([str(IVP_HELM), str(tmp_path / "missing.moos")], capture_output=True, text=True,
+                            timeout=60)
+    assert result.returncode == 2
+    assert "missing.moos" in result.stderr
