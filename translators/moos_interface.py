@@ -14,7 +14,7 @@ from collections.abc import Callable
 from typing import Any
 
 from gateway.moos.wildcard import wild_match
-from translators.techniques import Technique, is_binary, parse, serialize
+from translators.techniques import Technique, TechniqueError, is_binary, parse, serialize
 
 log = logging.getLogger(__name__)
 
@@ -118,8 +118,6 @@ class MOOSInterface:
         return parse(value, msg, chosen)
 
     def _protobuf_technique(self, technique: int | None) -> Technique:
-        from translators.techniques import TechniqueError
-
         chosen = self.technique if technique is None else Technique(technique)
         if chosen in (Technique.COMMA_SEPARATED_KEY_EQUALS_VALUE_PAIRS, Technique.FORMAT):
             raise TechniqueError(f"Non-PROTOBUF techniques are not supported for 'moos_parser_technique': "
