@@ -25,7 +25,8 @@ class Mailbox:
         self.name = name
         self._fd = os.eventfd(0, os.EFD_NONBLOCK | os.EFD_CLOEXEC)
         self._items: deque[tuple[Callable[..., Any], tuple[Any, ...]]] = deque()
-        self._lock = threading.Lock()
+        # re-entrant: a signal handler on the owner thread may wake it while the owner is inside post()
+        self._lock = threading.RLock()
         self._closed = False
 
     @property
