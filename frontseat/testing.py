@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import selectors
 import socket
 import subprocess
 import sys
@@ -71,10 +72,16 @@ def start_simulator(port: int = 0, verbosity: int = 0, timeout: float = 30.0) ->
     assert process.stdout is not None
     line = ""
     deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        line = process.stdout.readline()
-        if "listening on" in line or not line:
-            break
+    with selectors.DefaultSelector() as selector:  # never block past the deadline on a silent child
+        selector.register(process.stdout, selectors.EVENT_READ)
+        while time.monotonic() < deadline:
+            if not selector.select(timeout=0.2):
+                if process.poll() is not None:
+                    break
+                continue
+            line = process.stdout.readline()
+            if "listening on" in line or not line:
+                break
     if "listening on" not in line:
         process.kill()
         process.wait(timeout=10)
