@@ -35,6 +35,7 @@ def _values(settings: UsvSettings, app: str) -> dict[str, object]:
         "community": settings.community,
         "vehicle_id": settings.vehicle_id,
         "bhv_file": settings.bhv_file,
+        "timeout": settings.liveness_timeout,
     }
     values["app_block"] = render(TEMPLATES / "_app.pb.cfg.in", values)
     values["interprocess_block"] = render(TEMPLATES / "_interprocess.pb.cfg.in", values)

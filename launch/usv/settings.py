@@ -77,6 +77,15 @@ class UsvSettings:
         return self.socket_name or str(self.run_dir / f"goby_{self.platform}")
 
     @property
+    def liveness_timeout(self) -> int:
+        """Sim seconds without a helm report or frontseat data before the interface calls it an error.
+
+        The course uses 10; at warp 20 that is half a real second, less than a Python process needs to start
+        or than a busy machine may delay one message, so it grows with the warp (two real seconds).
+        """
+        return max(10, 2 * self.warp)
+
+    @property
     def moos_file(self) -> Path:
         return self.run_dir / f"{self.platform}.moos"
 

@@ -77,7 +77,9 @@ def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm):
     assert result.failure is None, report
 
     # The interface reached COMMAND and the helm drove the vehicle.
-    assert "INTERFACE_COMMAND" in [state for _, state in interface_timeline(record)], report
+    states = [state for _, state in interface_timeline(record)]
+    assert "INTERFACE_COMMAND" in states, report
+    assert states[states.index("INTERFACE_COMMAND"):] == ["INTERFACE_COMMAND"], report  # and stayed there
     assert "DRIVE" in [state for _, state in helm_timeline(record)], report
     assert len(record.nav) > 200, report
 
