@@ -14,8 +14,10 @@ import pytest
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import USV, DesiredCourse, NodeStatus
 from frontseat.protobuf.frontseat_pb2 import HELM_DRIVE, HELM_NOT_RUNNING, HELM_PARK, HelmStateReport
-from gateway.moos.testing import connected_comms
-from gateway.portal.testing import PortalClient
+from gateway.moos.testing import connected_comms, running_moosdb
+from gateway.portal.testing import PortalClient, broker_process
+from translators.frontseat_translation import FrontSeatTranslation
+from translators.testing import gateway_config, hosted_translators
 
 NAV_VARS = ["NAV_X", "NAV_Y", "NAV_LAT", "NAV_LONG", "NAV_DEPTH", "NAV_HEADING", "NAV_YAW", "NAV_SPEED",
             "NAV_PITCH", "NAV_ROLL", "GPS_UPDATE_RECEIVED", "NODE_REPORT"]
@@ -124,3 +126,24 @@ def test_ivphelm_state_becomes_helm_state(stack):
         assert client.poll_until(lambda: [r.state for r in reports][-5:] == expected, TIMEOUT_S), (
             [r.state for r in reports], stack.logs())
     assert all(r.state == HELM_NOT_RUNNING for r in reports[:-5])
+
+
+
+def test_a_string_setpoint_is_reported_and_the_translator_keeps_serving(tmp_path, caplog):
+    """A fresh MOOSDB (MOOS locks a variable's type at its first write, so this cannot share the stack's)."""
+    with running_moosdb(community="usv") as db, broker_process(tmp_path, platform="usv") as broker, \
+            hosted_translators(gateway_config(db.port, broker.interprocess_config()), FrontSeatTranslation), \
+            connected_comms(db.port, "sloppy_helm") as helm, \
+            PortalClient(broker.interprocess_config(), name="interface_bad") as client:
+        courses: list[DesiredCourse] = client.collect(groups.desired_course, DesiredCourse)
+        assert client.wait_subscribed()
+        deadline = time.monotonic() + TIMEOUT_S
+        while not any(c.time == 300.0 for c in courses):
+            assert time.monotonic() < deadline, "no desired_course arrived"
+            helm.notify("DESIRED_HEADING", "north", time=299.0)
+            helm.notify("DESIRED_DEPTH", 4.0, time=299.0)
+            helm.notify("DESIRED_SPEED", 0.75, time=300.0)
+            client.poll_until(lambda: any(c.time == 300.0 for c in courses), 0.5)
+    course = next(c for c in courses if c.time == 300.0)
+    assert course.speed == 0.75 and course.depth == 4.0 and not course.HasField("heading")
+    assert "DESIRED_HEADING must be a number, got the string 'north' from 'sloppy_helm'" in caplog.text
