@@ -168,7 +168,9 @@ def example_config(config_type: type[pb_message.Message] | pb_descriptor.Descrip
                    _seen: tuple[str, ...] = ()) -> str:
     """Every field of the configuration with its default, each commented with label, type and meaning.
 
-    Only the first member of a oneof is left uncommented, so the text parses back into ``config_type``.
+    The text parses back into ``config_type`` and, as given, changes nothing that matters: fields that would alter
+    behaviour just by being present are commented out (optional fields without a declared default, repeated
+    fields, later members of a oneof, optional blocks that contain required fields).  Required fields stay.
     """
     descriptor = config_type if isinstance(config_type, pb_descriptor.Descriptor) else config_type.DESCRIPTOR
     pad = "  " * _indent
@@ -179,7 +181,7 @@ def example_config(config_type: type[pb_message.Message] | pb_descriptor.Descrip
         if field.has_default_value:
             comment += f", default {_example_value(field)}"
         oneof = field.containing_oneof
-        off = "# " if oneof is not None and oneof.fields[0] is not field else ""
+        off = "# " if _comment_out(field) else ""
         if oneof is not None:
             comment += f"; one of {oneof.name}"
         if field.type == _FD.TYPE_MESSAGE:
@@ -190,13 +192,26 @@ def example_config(config_type: type[pb_message.Message] | pb_descriptor.Descrip
             lines.append(f"{pad}{off}{field.name} {{  # {comment}")
             body = example_config(sub, _indent + 1, (*_seen, descriptor.full_name))
             if off:
-                body = "\n".join(f"# {line}" for line in body.splitlines())
+                body = "\n".join(f"{pad}# {line[len(pad):]}" for line in body.splitlines())
             if body:
                 lines.append(body)
             lines.append(f"{pad}{off}}}")
         else:
             lines.append(f"{pad}{off}{field.name}: {_example_value(field)}  # {comment}")
     return "\n".join(lines)
+
+
+def _comment_out(field: pb_descriptor.FieldDescriptor) -> bool:
+    if _is_required(field):
+        return False
+    oneof = field.containing_oneof
+    if oneof is not None and oneof.fields[0] is not field:
+        return True
+    if _is_repeated(field):
+        return True
+    if field.type == _FD.TYPE_MESSAGE:
+        return any(_is_required(sub) for sub in field.message_type.fields)
+    return not field.has_default_value
 
 
 def debug_text(cfg: pb_message.Message) -> str:

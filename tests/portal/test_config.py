@@ -78,6 +78,10 @@ def test_example_config_is_complete_and_parses_back(config_type: type) -> None:
     for field in config_type.DESCRIPTOR.fields:
         assert field.name in text
     assert "# (optional)" in text or "(optional)" in text
+    assert parsed.app.HasField("name") is False and parsed.app.HasField("loop_frequency") is False
+    assert not parsed.app.HasField("geodesy")  # a block with required fields stays commented
+    if config_type is SampleAppConfig:
+        assert list(parsed.group) == [] and "# group: " in text
     if config_type is GobyDaemonConfig:
         assert parsed.interprocess.platform == "default_goby_platform"
         assert "required_client" in text
