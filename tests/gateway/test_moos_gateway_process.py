@@ -35,11 +35,12 @@ def _moos_to_goby(poster, peer: PortalClient, got: list[str], tag: str, buffered
     raise AssertionError(f"no {tag} message came through the gateway; got {got}")
 
 
-REAL = pytest.param("real", signal.SIGTERM, marks=[
+REAL = pytest.param("real", signal.SIGTERM, id="real-MOOSDB-SIGTERM", marks=[
     pytest.mark.interop, pytest.mark.skipif(real_moosdb_skip_reason() is not None, reason=str(real_moosdb_skip_reason()))])
 
 
-@pytest.mark.parametrize(("moosdb_kind", "stop_signal"), [("ours", signal.SIGTERM), ("ours", signal.SIGINT), REAL])
+@pytest.mark.parametrize(("moosdb_kind", "stop_signal"), [pytest.param("ours", signal.SIGTERM, id="ours-SIGTERM-restart"),
+                                                         pytest.param("ours", signal.SIGINT, id="ours-SIGINT"), REAL])
 def test_gateway_process_end_to_end(tmp_path, moosdb_kind, stop_signal):
     plugin = tmp_path / "echo_plugin.py"
     plugin.write_text(ECHO_PLUGIN)

@@ -72,6 +72,7 @@ def test_entry_points_are_selected_by_name_only():
         (ECHO_PLUGIN, "{dir}/echo.py:", "Failed to open plugin: '', reason: empty entry"),
         (ECHO_PLUGIN, "{dir}/echo.py,{dir}/echo.py", "is already loaded as {dir}/echo.py (listed twice"),
     ],
+    ids=["missing-module", "missing-file", "no-load", "import-error", "empty-entry", "listed-twice"],
 )
 def test_resolution_errors_name_the_plugin(tmp_path, source, entry, cause):
     entry = entry.format(dir=tmp_path)
@@ -101,6 +102,7 @@ def _run_gateway(tmp_path: Path, plugins: str | None, config: str, timeout: floa
         (NO_LOAD_PLUGIN, "{dir}/no_load.py", "Function load in plugin: {dir}/no_load.py does not exist"),
         (IMPORT_ERROR_PLUGIN, "{dir}/import_error.py", "No module named 'no_such_dependency_xyz'"),
     ],
+    ids=["unset", "missing-module", "no-load", "import-error"],
 )
 def test_console_script_exits_1_before_anything_runs(tmp_path, source, plugins, cause):
     if plugins is not None:
