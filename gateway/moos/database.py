@@ -155,10 +155,11 @@ class MoosDatabase:
         """Apply a packet's messages (a leading T already removed); return (server-request replies, had N)."""
         replies: list[MoosMessage] = []
         had_notify = False
+        now = self.clock.time()
         for msg in messages:
             kind = msg.msg_type
             if kind == NOTIFY:
-                self.notify(msg)
+                self.notify(msg, now)
                 had_notify = True
             elif kind == REGISTER:
                 self.register(msg.raw_src, msg.raw_key, msg.dval)
@@ -171,12 +172,13 @@ class MoosDatabase:
                 self.wildcard_unregister(msg.raw_src, app, var)
             elif kind == SERVER_REQUEST:
                 replies[:0] = self.server_request(msg)
-        self.maybe_publish_summaries()
+        self.maybe_publish_summaries(now)
         return replies, had_notify
 
-    def notify(self, msg: MoosMessage) -> bool:
+    def notify(self, msg: MoosMessage, now: float | None = None) -> bool:
         """``OnNotify``: store, type-lock, fan out to due subscribers. False when the type lock rejects it."""
-        now = self.clock.time()
+        if now is None:
+            now = self.clock.time()
         key = msg.raw_key
         var = self.vars.get(key)
         if var is None:
@@ -214,20 +216,19 @@ class MoosDatabase:
             else:
                 var.write_freq = 0.5 * var.write_freq + 0.5 / (dt / (var.written - var.stats_writes))
             var.stats_writes, var.stats_time = var.written, now
-        if var.subscribers:
+        subscribers = var.subscribers
+        if subscribers:
             msg.msg_type = NOTIFY
-            wire = None
+            wire = encode_message(msg)
             held = self.held
-            for client, info in var.subscribers.items():
+            waiting = self.mail_waiting
+            for client, info in subscribers.items():
                 if info[0] == 0.0 or now - info[1] >= info[0]:
                     box = held.get(client)
-                    if box is None:
-                        continue
-                    if wire is None:
-                        wire = encode_message(msg)
-                    box.append(wire)
-                    self.mail_waiting.add(client)
-                    info[1] = now
+                    if box is not None:
+                        box.append(wire)
+                        waiting.add(client)
+                        info[1] = now
         return True
 
     def register(self, client: bytes, key: bytes, period: float) -> None:
@@ -324,9 +325,10 @@ class MoosDatabase:
         return replies
 
     # ---- DB_* variables ----------------------------------------------------------------------------
-    def maybe_publish_summaries(self) -> None:
+    def maybe_publish_summaries(self, now: float | None = None) -> None:
         """Every 2 s of DB MOOS time (checked when packets arrive): DB_TIME, DB_UPTIME, DB_CLIENTS, ..."""
-        now = self.clock.time()
+        if now is None:
+            now = self.clock.time()
         if now - self._summary_time <= SUMMARY_PERIOD_S:
             return
         self._summary_time = now
