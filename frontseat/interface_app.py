@@ -81,16 +81,26 @@ class FrontSeatInterface(MultiThreadApplication):
 
     # ----- wiring -----------------------------------------------------------------------------------------
     def _connect_driver(self) -> None:
-        portal = self.interprocess()
-        self._driver.signal_command_response.connect(lambda r: portal.publish(groups.command_response, r))
+        self._driver.signal_command_response.connect(self._on_command_response)
         self._driver.signal_data_from_frontseat.connect(self._on_data_from_frontseat)
-        self._driver.signal_raw_from_frontseat.connect(lambda raw: portal.publish(groups.raw_in, raw))
-        self._driver.signal_raw_to_frontseat.connect(lambda raw: portal.publish(groups.raw_out, raw))
+        self._driver.signal_raw_from_frontseat.connect(self._on_raw_from_frontseat)
+        self._driver.signal_raw_to_frontseat.connect(self._on_raw_to_frontseat)
+
+    # ----- driver signals (main thread, inside do_work) --------------------------------------------------
+    def _on_command_response(self, response: fs_pb.CommandResponse) -> None:
+        self.interprocess().publish(groups.command_response, response)
 
     def _on_data_from_frontseat(self, data: fs_pb.InterfaceData) -> None:
         self.interprocess().publish(groups.data_from_frontseat, data)
         if data.HasField("node_status"):
-            self.interprocess().publish(groups.node_status, data.node_status)
+            node_status: data_pb.NodeStatus = data.node_status
+            self.interprocess().publish(groups.node_status, node_status)
+
+    def _on_raw_from_frontseat(self, raw: fs_pb.Raw) -> None:
+        self.interprocess().publish(groups.raw_in, raw)
+
+    def _on_raw_to_frontseat(self, raw: fs_pb.Raw) -> None:
+        self.interprocess().publish(groups.raw_out, raw)
 
     def _subscribe(self) -> None:
         portal = self.interprocess()
@@ -189,7 +199,7 @@ class FrontSeatInterface(MultiThreadApplication):
         if self._next_status is not None and now < self._next_status:
             return
         self._next_status = now + period if self._next_status is None else max(self._next_status + period, now)
-        status = self._driver.status()
+        status: fs_pb.InterfaceStatus = self._driver.status()
         log.debug("status: %s", status)
         self.interprocess().publish(groups.status, status)
 
