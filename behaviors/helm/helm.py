@@ -62,6 +62,7 @@ class Helm:
         self._posted_state = ""
         self._seen_own_state = False
         self._deferred_done = False
+        self._nav_warned = False
         self._bhv_lists: dict[str, str] = {}
         self._outbox: list[Post] = []
 
@@ -136,6 +137,10 @@ class Helm:
             return out
         needed = NAV_VARS + (("NAV_DEPTH",) if self.config.domain.has("depth") else ())
         if not all(self.info.is_known(v) for v in needed):
+            if not self._nav_warned and now - self.start_time > self.config.nav_grace:
+                self._nav_warned = True
+                missing = ", ".join(v for v in needed if not self.info.is_known(v))
+                log.warning("Waiting for Helm Nav Solution (no %s after %.0f s)", missing, now - self.start_time)
             return out
         out.extend(self._deferred_initializes(now))
         if self.state == "PARK":
