@@ -268,3 +268,35 @@ def test_constructor_failing_after_connecting_does_not_hang_shutdown(broker: Bro
     with pytest.raises((RuntimeError, ThreadError), match="late"):
         with running_app(app_class, cfg):
             pass
+
+
+class EarlyPublisher(SimpleThread):
+    """Publishes from a launched thread while the process is still held by the manager."""
+
+    def __init__(self, cfg: SampleAppConfig) -> None:
+        super().__init__(cfg)
+        self.held_at_publish = self.interprocess().hold_state()
+        for a in range(1, 4):
+            self.interprocess().publish("early", Sample(a=a))
+
+
+class EarlyApp(MultiThreadApplication):
+    def __init__(self, cfg: SampleAppConfig) -> None:
+        super().__init__(cfg)
+        self.publisher = self.launch_thread(EarlyPublisher)
+
+
+def test_publications_of_a_launched_thread_wait_for_the_hold(tmp_path: Path) -> None:
+    from gateway.portal.testing import broker_process
+
+    hold = ["--hold", 'required_client: "early_app" required_client: "early_rx"']
+    with broker_process(tmp_path, platform="early", extra_args=hold) as broker, \
+            PortalClient(broker.interprocess_config(), "early_rx") as rx:
+        got = rx.collect("early", Sample)
+        cfg = SampleAppConfig()
+        cfg.app.name = "early_app"
+        cfg.interprocess.CopyFrom(broker.interprocess_config())
+        with running_app(EarlyApp, cfg) as app:
+            assert app.publisher.held_at_publish is True
+            assert rx.poll_until(lambda: len(got) == 3, 30)
+    assert [m.a for m in got] == [1, 2, 3]
