@@ -41,7 +41,9 @@ class Translator(SimpleThread):
 
     def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None) -> None:
         super().__init__(cfg, LOOP_FREQUENCY_HZ, index)
-        self._name = f"goby::moos::Translator::{threading.get_ident()}"
+        # Goby prints std::this_thread::get_id() (a pthread_t); the kernel thread id has the same shape and is
+        # unique across processes too, so two gateways on one MOOSDB never clash.
+        self._name = f"goby::moos::Translator::{threading.get_native_id()}"
         sim = cfg.app.simulation.time
         if sim.use_sim_time:
             moos.set_moos_timewarp(float(sim.warp_factor))  # process-global, as Goby's SetMOOSTimeWarp
@@ -67,7 +69,7 @@ class Translator(SimpleThread):
         return self._moos
 
     def translator_name(self) -> str:
-        """``goby::moos::Translator::<thread id>``: this translator's MOOS client name (unique per thread)."""
+        """``goby::moos::Translator::<thread id>``: this translator's MOOS client name (unique on the host)."""
         return self._name
 
     def run(self) -> None:
