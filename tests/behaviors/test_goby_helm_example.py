@@ -82,8 +82,9 @@ def test_triangle_through_the_real_frontseat_path(tmp_path: Path) -> None:
     x0, y0, _ = track[0]
     east_end = max(track, key=lambda p: p[0])
     south_end = min(track, key=lambda p: p[1])
-    assert 40 < east_end[0] - x0 < 80  # about 1.5 m/s for 40 s, less the start-up acceleration
-    assert 25 < y0 - south_end[1] < 55  # about 1.5 m/s for 30 s
+    # about 1.5 m/s for 40 s east and 30 s south; wide bounds: the simulator's start-up and turns take time
+    assert 20 < east_end[0] - x0 < 80
+    assert 15 < y0 - south_end[1] < 55
     ranges = [math.hypot(x - x0, y - y0) for x, y, _ in track]
     closest = min(ranges[ranges.index(max(ranges)):])
     assert ranges[-1] < closest + 15  # it stopped soon after it stopped closing on the start

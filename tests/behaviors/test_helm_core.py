@@ -9,6 +9,7 @@ import pytest
 
 from .core_loop import CoreLoop, make_helm
 from .kinematic_vehicle import KinematicModel
+from .moos_harness import ring_stats
 
 WAYPOINTS = """\
 initialize DEPLOY = false
@@ -102,18 +103,6 @@ Behavior = BHV_Loiter
   polygon = radial:: x=0,y=0,radius=60,pts=8
 }
 """
-
-
-def ring_stats(track, cx: float, cy: float, since: float) -> tuple[float, float, float]:
-    """(min, max distance from the centre, total signed bearing change around it; + is clockwise)."""
-    pts = [(x, y) for t, x, y, _, _ in track if t >= since]
-    radii = [math.hypot(x - cx, y - cy) for x, y in pts]
-    turned = 0.0
-    for (x1, y1), (x2, y2) in zip(pts, pts[1:], strict=False):
-        a1 = math.degrees(math.atan2(x1 - cx, y1 - cy))
-        a2 = math.degrees(math.atan2(x2 - cx, y2 - cy))
-        turned += (a2 - a1 + 180) % 360 - 180
-    return min(radii), max(radii), turned
 
 
 @pytest.mark.parametrize("clockwise", [True, False])
