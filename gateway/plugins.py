@@ -8,7 +8,8 @@ Why this shape: goby_moos_gateway ``dlopen``s the libraries listed in the variab
 2. the name of an entry point in the ``goby_moos_gateway.plugins`` group (``frontseat``, ``usv_command``,
    ``node_report`` ship with this package; installed packages can add more).  Only entry points that are
    *named* are loaded -- installing a package never adds a plugin to a gateway by itself.  Goby's library
-   file names (``libgoby_ivp_frontseat_moos_gateway_plugin.so``) are accepted as aliases of ours;
+   file names (``libgoby_ivp_frontseat_moos_gateway_plugin.so``, with or without a directory) are accepted as
+   aliases of ours;
 3. a dotted module name, imported with ``importlib``.
 
 Everything is resolved (imported, ``load`` found) before the gateway starts, so a bad entry stops the
@@ -101,7 +102,9 @@ def resolve_plugin(entry: str) -> Plugin:
 
 
 def _import(entry: str) -> ModuleType:
-    if entry.endswith(".py") or "/" in entry:
+    if _library_stem(Path(entry).name) in GOBY_LIBRARY_ALIASES:  # Goby's .so name, with or without a directory
+        entry = Path(entry).name
+    elif entry.endswith(".py") or "/" in entry:
         return _import_file(entry)
     entry_point = _entry_point(entry)
     if entry_point is not None:

@@ -62,6 +62,11 @@ def test_entry_points_are_selected_by_name_only():
     assert _entry_point("translators.frontseat_translation") is None  # a dotted name is a module, not an entry point
 
 
+def test_goby_library_path_loads_our_frontseat_plugin():
+    plugin = resolve_plugin("/usr/lib/x86_64-linux-gnu/libgoby_ivp_frontseat_moos_gateway_plugin.so.30")
+    assert plugin.module.__name__ == "translators.frontseat_translation" and callable(plugin.load)
+
+
 @pytest.mark.parametrize(
     ("source", "entry", "cause"),
     [
