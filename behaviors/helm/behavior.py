@@ -221,6 +221,8 @@ class Behavior:
         self.outbox.append(Posting(mapped, value, repeatable, key))
 
     def post_flags(self, kind: str, repeatable: bool = True) -> None:
+        if not self.flags[kind]:
+            return
         macros = self.macros()
         for flag in self.flags[kind]:
             if flag.condition is None or flag.condition.evaluate(self.info.get):

@@ -7,6 +7,7 @@ over behaviours is maximised one decision variable at a time over that variable'
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 from .errors import ParamError
 from .logic import is_number
@@ -20,12 +21,16 @@ class DomainVar:
     points: int
     optional: bool = False
 
-    @property
+    @cached_property
     def delta(self) -> float:
         return 0.0 if self.points <= 1 else (self.high - self.low) / (self.points - 1)
 
+    @cached_property
+    def _grid(self) -> tuple[float, ...]:
+        return tuple(self.low + j * self.delta for j in range(self.points))
+
     def grid(self) -> list[float]:
-        return [self.low + j * self.delta for j in range(self.points)]
+        return list(self._grid)
 
     def snap(self, value: float, wrap: bool = False) -> float:
         """The grid value nearest ``value`` (circular for a wrapping variable such as course)."""
@@ -86,22 +91,27 @@ def _g(value: float) -> str:
 def zaic_peak(var: DomainVar, summit: float, peakwidth: float, basewidth: float, summitdelta: float,
               minutil: float = 0.0, maxutil: float = 100.0, wrap: bool = False) -> list[float]:
     """ZAIC_PEAK utilities over ``var``'s grid (spec §6), circular distance when ``wrap``."""
-    grid = var.grid()
+    grid = var._grid
     period = var.high - var.low + var.delta
     sd = summitdelta if peakwidth > 0 else 0.0
+    peak_slope = sd / peakwidth if peakwidth > 0 else 0.0
+    base_top = maxutil - sd
+    base_slope = (base_top - minutil) / basewidth if basewidth > 0 else 0.0
+    outer = peakwidth + basewidth
     out = []
+    append = out.append
     for x in grid:
         d = abs(x - summit)
         if wrap:
-            d = d % period
-            d = min(d, period - d)
+            d %= period
+            if period - d < d:
+                d = period - d
         if d <= peakwidth:
-            u = maxutil - (sd / peakwidth) * d if peakwidth > 0 else maxutil
-        elif d <= peakwidth + basewidth:
-            u = (maxutil - sd) - ((maxutil - sd - minutil) / basewidth) * (d - peakwidth)
+            append(maxutil - peak_slope * d)
+        elif d <= outer:
+            append(base_top - base_slope * (d - peakwidth))
         else:
-            u = minutil
-        out.append(u)
+            append(minutil)
     if all(u == minutil for u in out):
         nearest = min(range(len(grid)), key=lambda j: abs(grid[j] - summit))
         out[nearest] = maxutil
@@ -147,11 +157,12 @@ def solve(domain: IvPDomain, functions: list[ObjectiveFunction]) -> dict[str, fl
             piece = fn.pieces.get(name)
             if piece is None or fn.pwt <= 0:
                 continue
+            pwt = fn.pwt
             if scores is None:
-                scores = [0.0] * var.points
-            for j, u in enumerate(piece):
-                scores[j] += fn.pwt * u
+                scores = [pwt * u for u in piece]
+            else:
+                scores = [s + pwt * u for s, u in zip(scores, piece, strict=True)]
         if scores is not None:
-            best = max(range(var.points), key=lambda j: (scores[j], -j))
+            best = max(range(var.points), key=scores.__getitem__)  # the first maximum: lowest index
             decisions[name] = var.low + best * var.delta
     return decisions
