@@ -123,14 +123,15 @@ def test_broker_killed_and_restarted_mid_stream(
     with PortalClient(broker.interprocess_config(), "restart_rx") as rx:
         got = rx.collect("stream", Sample)
         assert rx.wait_subscribed()
-        with sample_app(broker, tmp_path, "tx", "--group", "stream", "--count", "400",
-                        "--publish_period", "0.02") as tx:
+        with sample_app(broker, tmp_path, "tx", "--group", "stream", "--count", "5000",
+                        "--publish_period", "0.02") as tx:  # long enough to outlast a slow restart
             assert rx.poll_until(lambda: len(got) >= 20, 30), tx.stderr_text()
             broker.kill()  # a crash: the IPC files stay behind
             rx.poll(0.5)
             before = max(m.a for m in got)
             broker.start()
-            assert rx.poll_until(lambda: any(m.a > before + 20 for m in got), 30), tx.stderr_text()
+            assert rx.poll_until(lambda: any(m.a > before + 20 for m in got), 60), tx.stderr_text()
+            assert rx.poll_until(lambda: "reconnected to the broker" in tx.stderr_text(), 20)
             tx.stop()
             tx_log = tx.stderr_text()
     assert "lost connection to the broker" in caplog.text
