@@ -136,3 +136,37 @@ def test_console_script_reports_an_unreadable_mission(tmp_path: Path) -> None:
                             timeout=60)
     assert result.returncode == 2
     assert "missing.moos" in result.stderr
+
+
+LOITER_UPDATES = """\
+initialize GO = false
+Behavior = BHV_Loiter
+{
+  name = l
+  condition = GO = true
+  speed = 2
+  clockwise = best
+  updates = UP
+  polygon = radial:: x=0,y=0,radius=50,pts=8
+}
+"""
+
+
+def test_loiter_best_direction_center_assign_and_radius_updates(tmp_path: Path) -> None:
+    # west of the polygon heading south: turning the least means going round counter-clockwise
+    loop = CoreLoop(make_helm(tmp_path, LOITER_UPDATES, start_engaged="true"),
+                    KinematicModel(x=-120, y=0, heading=180))
+    loop.run(2)  # the helm makes no decision in its first second
+    loop.poke("GO", "true")  # best is chosen on each idle-to-running transition
+    loop.run(1)
+    loiter = loop.helm.engine.behaviors[0]
+    assert loiter.clockwise is False and not loiter.polygon.is_clockwise()
+    loop.poke("UP", "center_assign=30,-40")
+    loop.run(1)
+    assert loiter.polygon.center() == (30, -40)
+    loop.poke("UP", "mod_poly_rad=-20")
+    loop.run(1)
+    assert abs(loiter.polygon.max_radius() - 30) < 0.01 and loiter.polygon.center() == (30, -40)
+    loop.poke("UP", "mod_poly_rad=-100")
+    loop.run(1)
+    assert abs(loiter.polygon.max_radius() - 5) < 0.01  # pHelmIvP's minimum radius
