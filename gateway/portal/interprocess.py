@@ -258,7 +258,8 @@ class InterProcessPortal:
     def subscribe_type_regex(
         self, group: GroupLike, callback: RegexCallback, type_regex: str = ".*", scheme: int = Scheme.PROTOBUF
     ) -> None:
-        """Regex subscription on one group (escaped) for every type matching ``type_regex``."""
+        """Regex subscription on one group (escaped) for every type matching ``type_regex``; ``callback`` runs on the
+        owning thread, as for :meth:`subscribe_regex`."""
         self.subscribe_regex(callback, re.escape(str(as_group(group))), type_regex, (scheme,))
 
     # ------------------------------------------------------------------------------------------- hold

@@ -256,7 +256,7 @@ class PortalClient:
         self.portal.subscribe(group, msg_type, callback, **kwargs)
 
     def collect(self, group: GroupLike, msg_type: type, **kwargs: Any) -> list[Any]:
-        """Subscribe and return the list the received messages are appended to."""
+        """Subscribe and return the list the received messages are appended to (inside :meth:`poll`, this thread)."""
         received: list[Any] = []
         self.portal.subscribe(group, msg_type, received.append, **kwargs)
         return received
