@@ -114,6 +114,7 @@ class ProcessGroup:
         self.report = report
         self.processes: list[ManagedProcess] = []
         self.stop_event = threading.Event()
+        self._named_once = False
 
     # -- start-up -------------------------------------------------------------------------------
 
@@ -236,7 +237,9 @@ class ProcessGroup:
         stamp = time.strftime("%H:%M:%S")
         running = self.running()
         if len(running) == len(self.processes):
-            self.report(f"[{self.platform}] {stamp}: All processes running ({len(running)})")
+            names = "" if self._named_once else ": " + ", ".join(p.name for p in running)
+            self._named_once = True
+            self.report(f"[{self.platform}] {stamp}: All processes running ({len(running)}){names}")
             return
         for process in self.processes:
             if not process.running:

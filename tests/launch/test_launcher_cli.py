@@ -111,7 +111,7 @@ def test_starts_in_order_and_stops_in_reverse_on_sigint(tmp_path, child_script):
     logs = tmp_path / "logs"
     run = LauncherRun(launch_file, logs)
     try:
-        run.wait_for_output("All processes running (3)")
+        run.wait_for_output("All processes running (3): first, second, third")
         _wait_for(lambda: all("up" in (logs / f"{n}.log").read_text() for n in ("first", "second", "third")),
                   what="all three children up")
         run.proc.send_signal(signal.SIGINT)
