@@ -49,6 +49,7 @@ def write_track_png(
             [s.y for s in samples],
             color=PHASE_COLOURS.get(state, "tab:gray"),
             linewidth=1.4,
+            zorder=3,
             label=None if label in labelled else label,
         )
         labelled.add(label)
@@ -67,7 +68,7 @@ def write_track_png(
         where = next((s for s in nav if s.t >= command.t), nav[-1] if nav else None)
         if where is None:
             continue
-        ax.plot(where.x, where.y, marker="o", markersize=9, color="tab:red", linestyle="none",
+        ax.plot(where.x, where.y, marker="o", markersize=9, color="tab:red", linestyle="none", zorder=4,
                 label="command arrived" if n == 1 else None)
         ax.annotate(f"{n}: {command.state}\nt={command.t:.0f} s", (where.x, where.y), textcoords="offset points",
                     xytext=(8, 8), fontsize=8, color="tab:red")
