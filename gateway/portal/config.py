@@ -64,6 +64,8 @@ def build_parser(config_type: type[pb_message.Message], prog: str | None = None)
     parser.add_argument("-c", "--cfg_path", help="configuration file (alternative to the positional argument)")
     parser.add_argument("-e", "--example_config", action="store_true", help="print a commented example and exit")
     parser.add_argument("-a", "--app_name", help="set app.name")
+    parser.add_argument("-n", "--ncurses", action="store_true",
+                        help="accepted for compatibility with Goby command lines; there is no ncurses GUI (ignored)")
     add_verbosity_argument(parser)
     for field in config_type.DESCRIPTOR.fields:
         kind = "message (text format)" if field.type == _FD.TYPE_MESSAGE else _type_label(field)

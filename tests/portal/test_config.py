@@ -47,7 +47,8 @@ def test_goby_interprocess_env_only_when_no_block(tmp_path: Path) -> None:
 
 
 def test_glog_tty_verbosity_and_app_name_flag() -> None:
-    loaded = load_config(SampleAppConfig, ["--app", "glog_config { tty_verbosity: DEBUG1 }", "-a", "named"], environ={})
+    loaded = load_config(SampleAppConfig, ["--app", "glog_config { tty_verbosity: DEBUG1 }", "-a", "named", "-n"],
+                         environ={})
     assert loaded.verbosity == 2
     assert loaded.cfg.app.name == "named"
 
