@@ -15,6 +15,7 @@ from .errors import BehaviorFileError, ConditionError, ParamError, UnknownParamE
 from .info_buffer import InfoBuffer, Value
 from .ivp import IvPDomain
 from .logic import is_number
+from .modes import ModeEntry
 from .registry import behavior_class
 
 
@@ -38,10 +39,14 @@ class BehaviorFile:
     path: str
     initializes: list[Initialize] = field(default_factory=list)
     blocks: list[BehaviorBlock] = field(default_factory=list)
+    modes: list[ModeEntry] = field(default_factory=list)
 
 
 def _logical_lines(text: str) -> list[tuple[int, str]]:
-    """Lines with ``//`` comments removed, ``\\``-continuations joined, and braces split off as pHelmIvP does."""
+    """Lines with ``//`` comments removed, ``\\``-continuations joined, and braces split off as pHelmIvP does.
+
+    Blank lines come back as ``""``: they end a ``set`` block's optional else-value.
+    """
     out: list[tuple[int, str]] = []
     pending, pending_no = "", 0
     for number, raw in enumerate(text.splitlines(), start=1):
@@ -55,6 +60,7 @@ def _logical_lines(text: str) -> list[tuple[int, str]]:
         pending = ""
         line = line.strip()
         if not line:
+            out.append((number, ""))
             continue
         if not line.startswith("#"):
             if len(line) > 1 and line[0] in "{}":
@@ -95,7 +101,34 @@ def parse_bhv_text(text: str, path: str = "<string>") -> BehaviorFile:
     result = BehaviorFile(path)
     block: BehaviorBlock | None = None
     awaiting_brace: BehaviorBlock | None = None
+    mode: ModeEntry | None = None  # a set block: declared, open, or closed and waiting for an else-value
+    mode_state = ""
     for number, line in _logical_lines(text):
+        if mode is not None and mode_state == "closed":
+            head_word = line.split(None, 1)[0].lower() if line else ""
+            if line and head_word not in ("initialize", "initialize_", "set") and not _is_behavior_line(line):
+                try:
+                    mode.set_else(line)
+                except ParamError as exc:
+                    raise BehaviorFileError(path, number, line, str(exc)) from exc
+                line = ""
+            result.modes.append(mode)
+            mode, mode_state = None, ""
+        if not line:
+            continue
+        if mode is not None:
+            if mode_state == "declared":
+                if line != "{":
+                    raise BehaviorFileError(path, number, line, "expected '{' after the set line")
+                mode_state = "open"
+            elif line == "}":
+                mode_state = "closed"
+            else:
+                try:
+                    mode.add_condition(line)
+                except (ParamError, ConditionError) as exc:
+                    raise BehaviorFileError(path, number, line, str(exc)) from exc
+            continue
         if awaiting_brace is not None:
             if line != "{":
                 raise BehaviorFileError(path, number, line, "expected '{' after the Behavior line")
@@ -124,13 +157,16 @@ def parse_bhv_text(text: str, path: str = "<string>") -> BehaviorFile:
                 if not sep or not var or any(c.isspace() for c in var):
                     raise BehaviorFileError(path, number, item.strip() or line, "expected 'initialize VAR = value'")
                 result.initializes.append(Initialize(var, _auto_type(value), deferred, number))
-        elif line.replace(" ", "").lower().startswith("behavior="):
+        elif _is_behavior_line(line):
             type_name = line.split("=", 1)[1].strip()
             if not type_name:
                 raise BehaviorFileError(path, number, line, "missing behaviour type")
             awaiting_brace = BehaviorBlock(type_name, number)
         elif lowered == "set":
-            raise BehaviorFileError(path, number, line, "hierarchical modes ('set' blocks) are not supported")
+            var, sep, value = line[len(head):].partition("=")
+            if not sep or not var.strip() or not value.strip() or any(c.isspace() for c in var.strip()):
+                raise BehaviorFileError(path, number, line, "expected 'set VAR = value'")
+            mode, mode_state = ModeEntry(var.strip(), value.strip(), number), "declared"
         elif line.startswith("#"):
             raise BehaviorFileError(path, number, head, "preprocessor line: run nsplug on the file first")
         elif line in ("{", "}"):
@@ -140,7 +176,15 @@ def parse_bhv_text(text: str, path: str = "<string>") -> BehaviorFile:
     if awaiting_brace is not None or block is not None:
         opened = (awaiting_brace or block).line  # type: ignore[union-attr]
         raise BehaviorFileError(path, opened, "Behavior", "behaviour block is not closed")
+    if mode is not None:
+        if mode_state != "closed":
+            raise BehaviorFileError(path, mode.line, f"set {mode.var}", "set block is not closed")
+        result.modes.append(mode)
     return result
+
+
+def _is_behavior_line(line: str) -> bool:
+    return line.replace(" ", "").replace("\t", "").lower().startswith("behavior=")
 
 
 def read_bhv_file(path: str | os.PathLike[str]) -> BehaviorFile:

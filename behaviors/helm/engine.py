@@ -14,6 +14,8 @@ from .behavior import Behavior, Posting
 from .geometry import fmt_num
 from .info_buffer import InfoBuffer, Value
 from .ivp import IvPDomain, ObjectiveFunction, solve
+from .logic import is_number
+from .modes import ModeSet
 
 log = logging.getLogger(__name__)
 
@@ -27,13 +29,17 @@ class EngineResult:
     postings: list[Posting]
     states: dict[str, str] = field(default_factory=dict)
     removed: list[str] = field(default_factory=list)
+    modes: dict[str, str] = field(default_factory=dict)
 
 
 class HelmEngine:
     """Runs the behaviours in declaration order and solves the weighted sum of their functions."""
 
-    def __init__(self, domain: IvPDomain, behaviors: list[Behavior], info: InfoBuffer) -> None:
+    def __init__(self, domain: IvPDomain, behaviors: list[Behavior], info: InfoBuffer,
+                 modes: ModeSet | None = None) -> None:
         self.domain, self.behaviors, self.info = domain, list(behaviors), info
+        self.modes = modes or ModeSet()
+        self._posted_modes: dict[str, str] = {}
         self.iteration = 0
         self._last_posted: dict[str, Value] = {}
         self._configured: set[str] = set()
@@ -46,6 +52,13 @@ class HelmEngine:
         self.iteration += 1
         functions: list[ObjectiveFunction] = []
         extra: list[Posting] = []
+        modes = self.modes.evaluate(self.info) if self.modes else {}
+        for var, value in modes.items():
+            typed: Value = float(value) if is_number(value) else value
+            self.info.set(var, typed, now)
+            if self._posted_modes.get(var) != value:
+                self._posted_modes[var] = value
+                extra.append(Posting(var, typed, key="mode_set"))
         states: dict[str, str] = {}
         for bhv in self.behaviors:
             bhv.now = now
@@ -67,7 +80,7 @@ class HelmEngine:
                                         f"iter={self.iteration},time={fmt_num(now, 2)},bname={bhv.name},"
                                         f"btype={bhv.TYPE},event=death", repeatable=True))
         self.behaviors = [b for b in self.behaviors if b.name not in removed]
-        return EngineResult(decisions, len(functions), postings, states, removed)
+        return EngineResult(decisions, len(functions), postings, states, removed, modes)
 
     def _apply_updates(self, bhv: Behavior, now: float) -> list[Posting]:
         results: list[Posting] = []

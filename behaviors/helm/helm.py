@@ -16,6 +16,7 @@ from .engine import HelmEngine
 from .errors import BehaviorFileError
 from .geometry import fmt_num
 from .info_buffer import InfoBuffer, Value
+from .modes import ModeEntry, ModeSet
 
 log = logging.getLogger(__name__)
 
@@ -43,17 +44,19 @@ class Helm:
         self.problems = list(config.problems)
         self.initializes: list[Initialize] = []
         behaviors: list[Behavior] = []
+        modes: list[ModeEntry] = []
         if not self.problems:
             try:
                 for path in sorted(config.behavior_files):
                     bfile = read_bhv_file(path)
                     self.initializes.extend(bfile.initializes)
+                    modes.extend(bfile.modes)
                     behaviors.extend(build_behaviors(bfile, config.domain, self.info, ownship))
             except BehaviorFileError as exc:
                 self.problems.append(str(exc))
         for problem in self.problems:
             log.error("MALCONFIG: %s", problem)
-        self.engine = HelmEngine(config.domain, [] if self.problems else behaviors, self.info)
+        self.engine = HelmEngine(config.domain, [] if self.problems else behaviors, self.info, ModeSet(modes))
         self.has_control = config.start_engaged
         self.state = "MALCONFIG" if self.problems else ("DRIVE" if self.has_control else "PARK")
         self.start_time: float | None = None
@@ -74,6 +77,7 @@ class Helm:
             names.add(self.config.other_override_var)
         for bhv in self.engine.behaviors:
             names |= bhv.info_vars()
+        names |= self.engine.modes.variables()
         names |= {init.var for init in self.initializes if init.deferred}
         return names
 
@@ -159,7 +163,7 @@ class Helm:
             message = "MissingDecVars:" + ",".join(missing)
         else:
             message = "clear"
-        out.append(Post("IVPHELM_SUMMARY", self._summary(result.decisions, result.states)))
+        out.append(Post("IVPHELM_SUMMARY", self._summary(result.decisions, result.states, result.modes)))
         out.extend(self._all_stop(message))
         if message == "clear":
             for var, value in result.decisions.items():
@@ -206,13 +210,14 @@ class Helm:
                 out.append(Post(f"IVPHELM_BHV_{kind.upper()}_CNT", float(len(names.split(",")) if names else 0)))
         return out
 
-    def _summary(self, decisions: dict[str, float], states: dict[str, str]) -> str:
+    def _summary(self, decisions: dict[str, float], states: dict[str, str], modes: dict[str, str]) -> str:
         def listed(kind: str) -> str:
             return ":".join(n for n, s in states.items() if s == kind) or "none"
 
         parts = [f"iter={self.engine.iteration}"]
         parts += [f"var={var}:{fmt_num(value)}" for var, value in decisions.items()]
-        parts += ["modes=none", f"active_bhvs={listed('active')}", f"running_bhvs={listed('running')}",
+        mode_text = "#".join(f"{var}@{value}" for var, value in modes.items()) or "none"
+        parts += [f"modes={mode_text}", f"active_bhvs={listed('active')}", f"running_bhvs={listed('running')}",
                   f"idle_bhvs={listed('idle')}", f"completed_bhvs={listed('completed')}"]
         return ",".join(parts)
 

@@ -138,7 +138,10 @@ BAD = [
     ("Behavior = BHV_ConstantDepth\n{\n depth = 3\n}\n", 1, "BHV_ConstantDepth", "'depth' decision variable"),
     ("Behavior = BHV_ConstantSpeed\n{\n name = a\n}\nBehavior = BHV_ConstantSpeed\n{\n name = ab\n}\n", 5, "ab",
      "prefix"),
-    ("set MODE = ACTIVE {\n DEPLOY = true\n}\n", 1, "set MODE", "modes"),
+    ("set MODE = ACTIVE {\n DEPLOY == true\n}\n", 2, "DEPLOY == true", "'==' is not allowed"),
+    ("set MODE = ACTIVE {\n DEPLOY = true\n} TWO WORDS\n", 3, "TWO WORDS", "one word"),
+    ("set MODE = ACTIVE {\n DEPLOY = true\n", 1, "set MODE", "not closed"),
+    ("set MODE {\n DEPLOY = true\n}\n", 1, "set MODE", "set VAR = value"),
 ]
 
 

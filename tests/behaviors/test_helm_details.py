@@ -170,3 +170,49 @@ def test_loiter_best_direction_center_assign_and_radius_updates(tmp_path: Path) 
     loop.poke("UP", "mod_poly_rad=-100")
     loop.run(1)
     assert abs(loiter.polygon.max_radius() - 5) < 0.01  # pHelmIvP's minimum radius
+
+
+MODES = """\
+initialize DEPLOY = false
+initialize RETURN = false
+
+set MODE = ACTIVE {
+  DEPLOY = true
+} INACTIVE
+
+set MODE = RETURNING {
+  MODE = ACTIVE
+  RETURN = true
+} LOITERING
+
+Behavior = BHV_ConstantSpeed
+{
+  name = slow
+  condition = MODE == LOITERING
+  speed = 1
+  duration = no-time-limit
+}
+Behavior = BHV_ConstantSpeed
+{
+  name = fast
+  condition = MODE == RETURNING
+  speed = 2
+  duration = no-time-limit
+}
+"""
+
+
+def test_hierarchical_modes(tmp_path: Path) -> None:
+    loop = CoreLoop(make_helm(tmp_path, MODES, domains=("speed:0:4:41",), start_engaged="true"))
+    assert {"DEPLOY", "RETURN", "MODE"} <= loop.helm.registrations()
+    loop.run(2)
+    assert loop.values("MODE") == ["INACTIVE"]  # on change only
+    assert "modes=MODE@INACTIVE" in loop.last("IVPHELM_SUMMARY")
+    loop.poke("DEPLOY", "true")
+    loop.run(1)
+    assert loop.last("MODE") == "ACTIVE:LOITERING" and loop.last("DESIRED_SPEED") == 1.0
+    loop.poke("RETURN", "true")
+    loop.run(1)
+    assert loop.last("MODE") == "ACTIVE:RETURNING" and loop.last("DESIRED_SPEED") == 2.0
+    assert "modes=MODE@ACTIVE:RETURNING" in loop.last("IVPHELM_SUMMARY")
+    assert loop.values("MODE") == ["INACTIVE", "ACTIVE:LOITERING", "ACTIVE:RETURNING"]
