@@ -57,6 +57,7 @@ class ScriptedHelm:
         self.data = client.collect(groups.data_from_frontseat, fs.InterfaceData)
         self.responses = client.collect(groups.command_response, fs.CommandResponse)
         self.driving = False
+        self.send_course = True
         self.course = (90.0, 2.0, 0.0)
         self._last_drive = 0.0
 
@@ -73,10 +74,11 @@ class ScriptedHelm:
             self._last_drive = now
             self.client.publish(groups.helm_state, fs.HelmStateReport(state=fs.HELM_DRIVE))
             heading, speed, depth = self.course
-            self.client.publish(
-                groups.desired_course,
-                data_pb.DesiredCourse(time=time.time(), heading=heading, speed=speed, depth=depth),
-            )
+            if self.send_course:
+                self.client.publish(
+                    groups.desired_course,
+                    data_pb.DesiredCourse(time=time.time(), heading=heading, speed=speed, depth=depth),
+                )
         self.client.poll(0.02)
 
     def until(self, predicate, timeout: float = 30.0, what: str = "") -> None:
@@ -146,13 +148,16 @@ def test_standby_listen_command_helm_error_fs_error_and_recovery(tmp_path: Path)
                 assert nav.local_fix.x > helm.node_status[0].local_fix.x
                 assert helm.data and helm.data[-1].HasField("node_status")
 
-                # a command request asking for a response gets one
+                # a command request asking for a response gets one. The driver matches a CMD reply to the last
+                # command sent (as Goby's does), so the helm's desired courses pause meanwhile.
+                helm.send_course = False
                 request = fs.CommandRequest(response_requested=True, request_id=42)
                 request.desired_course.time, request.desired_course.heading = time.time(), 90
                 request.desired_course.speed = 2
                 client.publish(groups.command_request, request)
                 helm.until(lambda: any(r.request_id == 42 for r in helm.responses), what="command response")
                 assert next(r for r in helm.responses if r.request_id == 42).request_successful
+                helm.send_course = True
 
                 # the helm stops: HELM_ERROR(NOT_RUNNING) once its last report is helm_running_timeout old
                 helm.driving = False
