@@ -65,6 +65,10 @@ class HelmEngine:
             extra.extend(self._apply_updates(bhv, now))
             fn = self._step(bhv, now)
             states[bhv.name] = bhv.state
+            failed = bhv.conditions_hold() if bhv.state == "idle" else None
+            good, total = bhv.update_counts
+            bhv.post("BHV_STATUS", f"name={bhv.name},pc={failed.text if failed else ''},pwt={fmt_num(bhv.pwt)},"
+                                   f"state={bhv.state},updates={good}/{total}", key="status")
             if fn is not None and bhv.pwt > 0:
                 functions.append(fn)
         decisions = solve(self.domain, functions)

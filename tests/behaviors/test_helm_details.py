@@ -216,3 +216,20 @@ def test_hierarchical_modes(tmp_path: Path) -> None:
     assert loop.last("MODE") == "ACTIVE:RETURNING" and loop.last("DESIRED_SPEED") == 2.0
     assert "modes=MODE@ACTIVE:RETURNING" in loop.last("IVPHELM_SUMMARY")
     assert loop.values("MODE") == ["INACTIVE", "ACTIVE:LOITERING", "ACTIVE:RETURNING"]
+
+
+def test_bhv_status_other_override_var_and_park_on_allstop(tmp_path: Path) -> None:
+    text = "initialize GO = false\nBehavior = BHV_ConstantSpeed\n{\n name = s\n condition = GO = true\n speed = 1\n" \
+           " duration = no-time-limit\n}\n"
+    loop = CoreLoop(make_helm(tmp_path, text, other_override_var="MY_OVERRIDE", park_on_allstop="true"))
+    loop.run(2)
+    assert loop.last("IVPHELM_STATE") == "PARK"
+    loop.poke("MY_OVERRIDE", "false")
+    loop.run(0.1)
+    assert loop.last("IVPHELM_STATE") == "DRIVE"
+    assert loop.values("BHV_STATUS") == ["name=s,pc=GO = true,pwt=100,state=idle,updates=0/0"]
+    assert loop.values("IVPHELM_ALLSTOP")[-1] == "NothingToDo"  # the grace iteration
+    loop.run(1)
+    # nothing to do persisted past the grace: park_on_allstop dropped control
+    assert loop.values("IVPHELM_STATE")[-1] == "PARK" and loop.values("IVPHELM_STATE").count("DRIVE") == 2
+    assert loop.values("BHV_STATUS") == ["name=s,pc=GO = true,pwt=100,state=idle,updates=0/0"]  # on change only
