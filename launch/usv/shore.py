@@ -1,9 +1,12 @@
-"""``python -m launch.usv.shore CONFIG --schedule ...``: the shore operator, sending USV commands at set sim times.
+"""``python -m launch.usv.shore CONFIG [--schedule ...]``: the shore operator, sending USV commands at set sim times.
 
 Sim time starts when the vehicle is first under helm command (the frontseat interface reports
-INTERFACE_COMMAND), so the plan does not depend on how long the processes took to start. Each command
-is sent with ``usv-command`` (the same tool a person would use), whose configuration is this script's own
-``interprocess`` block; its output goes to this script's log. The script stays up until stopped.
+INTERFACE_COMMAND), so the plan does not depend on how long the processes took to start. Each command is
+published the way ``usv-command`` publishes it (a ``goby3_course.dccl.USVCommand`` on the shore leg, checked
+against its DCCL bounds first), and every acknowledgement is printed to this script's log. Publishing from
+this process, rather than starting ``usv-command`` each time, keeps the commands on schedule: a Python
+process start costs a second or more, which is tens of simulated seconds at high warp. The script stays up
+until stopped.
 
 Schedule format: comma-separated ``T:waypoints`` or ``T:polygon:SIDES:RADIUS`` entries, T in sim seconds.
 """
@@ -13,21 +16,23 @@ from __future__ import annotations
 import argparse
 import logging
 import os
-import shutil
-import subprocess
 import sys
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 from google.protobuf import text_format
 
 from frontseat import groups as frontseat_groups
 from frontseat.protobuf.frontseat_pb2 import INTERFACE_COMMAND, InterfaceStatus
-from gateway.portal import SingleThreadApplication, run_application
+from gateway.portal import SingleThreadApplication, clock, run_application
 from launch.errors import ConfigError
 from launch.usv.settings import DEFAULT_SCHEDULE
+from translators.usv import groups as usv_groups
+from translators.usv.command_cli import describe_ack
+from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
+from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from translators.usv.protobuf.usv_config_pb2 import CommandTool
+from translators.usv.validation import DcclBoundsError, check_dccl_bounds
 
 log = logging.getLogger(__name__)
 PROG = "usv-shore"
@@ -42,6 +47,17 @@ class ScheduledCommand:
 
     def describe(self) -> str:
         return " ".join(self.args)
+
+    def to_message(self, now: float) -> USVCommand:
+        """The USVCommand, stamped ``now`` (the stamp also identifies its acknowledgements)."""
+        command = USVCommand(time=now)
+        if self.args[0] == "polygon":
+            command.desired_state = USVCommand.POLYGON
+            command.polygon_sides = int(self.args[2])
+            command.polygon_radius = int(self.args[4])
+        else:
+            command.desired_state = USVCommand.WAYPOINTS
+        return command
 
 
 def parse_schedule(text: str) -> list[ScheduledCommand]:
@@ -71,17 +87,16 @@ def parse_schedule(text: str) -> list[ScheduledCommand]:
 
 
 class ShoreOperator(SingleThreadApplication):
-    """Waits for INTERFACE_COMMAND, then runs ``usv-command`` for each entry when its sim time comes."""
+    """Waits for INTERFACE_COMMAND, then publishes each planned command when its sim time comes."""
 
-    def __init__(self, cfg: CommandTool, plan: list[ScheduledCommand], tool_config: Path) -> None:
+    def __init__(self, cfg: CommandTool, plan: list[ScheduledCommand]) -> None:
         super().__init__(cfg, loop_frequency_hz=2.0)
         self._plan = list(plan)
-        self._tool_config = tool_config
         self._warp = max(1, cfg.app.simulation.time.warp_factor) if cfg.app.simulation.time.use_sim_time else 1
         self._t0: float | None = None
-        self._running: subprocess.Popen[str] | None = None
-        self._running_cmd: ScheduledCommand | None = None
+        self._sent: dict[float, ScheduledCommand] = {}
         self.interprocess().subscribe(frontseat_groups.status, InterfaceStatus, self._on_status)
+        self.interprocess().subscribe(usv_groups.usv_command_ack, USVCommandAck, self._on_ack)
         print(f"shore: {len(plan)} commands planned: "
               + "; ".join(f"t={c.at:g} s {c.describe()}" for c in plan), flush=True)
 
@@ -94,50 +109,28 @@ class ShoreOperator(SingleThreadApplication):
             self._t0 = time.monotonic()
             print("shore: vehicle is under helm command; plan clock started", flush=True)
 
-    def loop(self) -> None:
-        """Reap a finished usv-command, start the next one when due. Runs on the main thread."""
-        if self._running is not None:
-            if self._running.poll() is None:
-                return
-            output = self._running.stdout.read() if self._running.stdout else ""
-            verdict = "acknowledged" if self._running.returncode == 0 else f"FAILED ({self._running.returncode})"
-            print(f"shore: t={self._sim_elapsed():.0f} s usv-command {self._running_cmd.describe()}: {verdict}\n"
-                  + output.rstrip(), flush=True)
-            if self._running.returncode != 0:
-                log.error("usv-command %s failed with status %s", self._running_cmd.describe(),
-                          self._running.returncode)
-            self._running = None
-        if self._t0 is None or not self._plan or self._plan[0].at > self._sim_elapsed():
+    def _on_ack(self, ack: USVCommandAck) -> None:
+        """Print acknowledgements of our commands. Runs on the main thread."""
+        command = self._sent.get(ack.command_time) if ack.HasField("command_time") else None
+        if command is None:
             return
-        command = self._plan.pop(0)
-        tool = shutil.which("usv-command") or "usv-command"
-        print(f"shore: t={self._sim_elapsed():.0f} s sending {command.describe()}", flush=True)
-        self._running_cmd = command
-        self._running = subprocess.Popen(
-            [tool, *command.args, str(self._tool_config)],
-            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, stdin=subprocess.DEVNULL,
-        )
+        print(f"shore: t={self._sim_elapsed():.0f} s {command.describe()}: {describe_ack(ack)}", flush=True)
+        if ack.stage == USVCommandAck.REFUSED:
+            log.error("command %s refused by %s: %s", command.describe(), ack.responder, ack.error)
 
-    def finalize(self) -> None:
-        if self._running is not None and self._running.poll() is None:
-            self._running.terminate()
+    def loop(self) -> None:
+        """Publish every command whose time has come. Runs on the main thread at 2 Hz (times warp)."""
+        while self._t0 is not None and self._plan and self._plan[0].at <= self._sim_elapsed():
+            planned = self._plan.pop(0)
             try:
-                self._running.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self._running.kill()
-                self._running.wait()
-
-
-def _tool_config_file(cfg: CommandTool) -> Path:
-    """usv-command's config: our app/interprocess blocks under its own name, in the run directory."""
-    tool = CommandTool()
-    tool.CopyFrom(cfg)
-    tool.app.name = "usv-command"
-    directory = Path(os.environ.get("USV_RUN_DIR") or "/tmp")
-    directory.mkdir(parents=True, exist_ok=True)
-    path = directory / f"usv-command.{os.getpid()}.pb.cfg"
-    path.write_text(text_format.MessageToString(tool))
-    return path
+                message = check_dccl_bounds(planned.to_message(clock.now()))
+            except DcclBoundsError as error:
+                log.error("not sending %s: %s", planned.describe(), error)
+                continue
+            self._sent[message.time] = planned
+            self.interprocess().publish(usv_groups.shore_usv_command, message)
+            print(f"shore: t={self._sim_elapsed():.0f} s sent {planned.describe()}: "
+                  f"{text_format.MessageToString(message, as_one_line=True)}", flush=True)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -155,17 +148,7 @@ def main(argv: list[str] | None = None) -> int:
     if not plan:
         print(f"{PROG}: empty schedule (--schedule or USV_SHORE_SCHEDULE)", file=sys.stderr)
         return 2
-    tool_config: list[Path] = []
-
-    def make_app(cfg: CommandTool) -> ShoreOperator:
-        tool_config.append(_tool_config_file(cfg))
-        return ShoreOperator(cfg, plan, tool_config[0])
-
-    try:
-        return run_application(make_app, CommandTool, goby_argv, prog=PROG)
-    finally:
-        for path in tool_config:
-            path.unlink(missing_ok=True)
+    return run_application(lambda cfg: ShoreOperator(cfg, plan), CommandTool, goby_argv, prog=PROG)
 
 
 if __name__ == "__main__":
