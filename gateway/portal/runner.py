@@ -66,11 +66,20 @@ def run_application(
     apply_simulation_time(cfg)
     context = ProcessContext(interprocess_config_of(cfg), application=app_name)
     app: SimpleThread | None = None
-    restore = _install_signal_handlers(lambda: app.quit() if app is not None else None)
+    stop_requested = threading.Event()  # a signal during construction must not be lost
+
+    def on_signal() -> None:
+        stop_requested.set()
+        if app is not None:
+            app.quit()
+
+    restore = _install_signal_handlers(on_signal)
     try:
         with use_context(context):
             try:
                 app = app_class(cfg)
+                if stop_requested.is_set():
+                    app.quit()
             except BrokerUnavailableError as exc:
                 log.critical("%s", exc)
                 return 1
