@@ -16,6 +16,7 @@ from typing import Any
 
 from google.protobuf import message as pb_message
 
+from gateway.portal.errors import ClosedError
 from gateway.portal.group import GroupLike, as_group, check_named
 from gateway.portal.interface_registry import InterfaceEntry, InterfaceRegistry, process_registry
 from gateway.portal.mailbox import Mailbox
@@ -90,15 +91,20 @@ class InterThread:
             for sub in list(targets):
                 if sub.mailbox is publisher and not echo:
                     continue
-                if not sub.mailbox.closed:
+                try:
                     sub.mailbox.post(sub.callback, msg)
                     count += 1
+                except ClosedError:
+                    pass  # the subscribing thread has just ended
         for rsub in list(regexes):
             if rsub.mailbox is publisher and not echo:
                 continue
-            if _regex_matches(rsub, Scheme.CXX_OBJECT, key, group) and not rsub.mailbox.closed:
-                rsub.mailbox.post(rsub.callback, msg, int(Scheme.CXX_OBJECT), key, group)
-                count += 1
+            if _regex_matches(rsub, Scheme.CXX_OBJECT, key, group):
+                try:
+                    rsub.mailbox.post(rsub.callback, msg, int(Scheme.CXX_OBJECT), key, group)
+                    count += 1
+                except ClosedError:
+                    pass
         return count
 
 
