@@ -78,6 +78,7 @@ GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
     "moos_gateway": _pb("moos_gateway.pb.cfg.in", "moos-gateway"),
     "usv_manager": _pb("usv_manager.pb.cfg.in", "usv-manager"),
     "shore": _pb("shore.pb.cfg.in", "usv-shore"),
+    "usv_command": _pb("shore.pb.cfg.in", "usv-command"),  # for sending commands by hand
     "moos": _moos,
 }
 
