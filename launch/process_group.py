@@ -99,6 +99,7 @@ class ProcessGroup:
         cwd: str | Path | None = None,
         parallel_stop: bool = False,
         report: Reporter = _print,
+        on_wait: Callable[[], None] | None = None,
     ) -> None:
         if not entries:
             raise LaunchError("nothing to launch: the launch file has no commands")
@@ -112,6 +113,8 @@ class ProcessGroup:
         self.cwd = Path(cwd) if cwd is not None else None
         self.parallel_stop = parallel_stop
         self.report = report
+        # Called on the starting thread while start() waits between launches (e.g. to read mail meanwhile).
+        self.on_wait = on_wait
         self.processes: list[ManagedProcess] = []
         self.stop_event = threading.Event()
         self._named_once = False
@@ -178,6 +181,8 @@ class ProcessGroup:
             died = self.check()
             if died is not None:
                 raise ProcessDiedError(died.name, died.returncode, died.log_tail())
+            if self.on_wait is not None:
+                self.on_wait()
             remaining = deadline - time.monotonic()
             if remaining <= 0 or self.stop_event.wait(min(POLL_PERIOD_S, remaining)):
                 return

@@ -121,9 +121,11 @@ class UsvMission:
             report=self.report,
         )
         self.group.stop_event = self.stop_event
-        # The MOOS client retries until the MOOSDB is up, so it sees the track from the first fix.
+        # The MOOS client retries until the MOOSDB is up, so it sees everything from the first posting; its mail
+        # is read while the launch waits between processes, so start-up events get their real times.
         self.moos = MoosRecorder(self.record, self.clock, self.settings)
         self.moos.start()
+        self.group.on_wait = self.moos.poll
         self.group.start()
         self.portal = PortalRecorder(self.record, self.clock, self.settings)
         self.portal.start()
