@@ -52,8 +52,8 @@ def command_posts(command: USVCommand) -> list[tuple[str, str]]:
 class CommandTranslation(Translator):
     """Turns ``goby3_course::usv_command`` into the MOOS variables the USV's behaviour file listens to."""
 
-    def __init__(self, cfg: GobyMOOSGatewayConfig) -> None:
-        super().__init__(cfg)
+    def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None) -> None:
+        super().__init__(cfg, index, comms_kind=comms_kind)
         self.goby().interprocess().subscribe(groups.usv_command, USVCommand, self._on_usv_command)
         log.info("Command Translation starting up")
 

@@ -42,8 +42,8 @@ def geodesy_from_config(cfg: GobyMOOSGatewayConfig) -> UTMGeodesy | None:
 class FrontSeatTranslation(Translator):
     """Moves navigation to the helm and the helm's setpoints and state to the frontseat interface."""
 
-    def __init__(self, cfg: GobyMOOSGatewayConfig) -> None:
-        super().__init__(cfg)
+    def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None) -> None:
+        super().__init__(cfg, index, comms_kind=comms_kind)
         self._geodesy = geodesy_from_config(cfg)
         if self._geodesy is None:
             log.warning("no app.geodesy datum configured: NAV_X/NAV_Y will be copied from node_status local_fix")

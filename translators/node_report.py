@@ -26,8 +26,8 @@ NODE_REPORT = "NODE_REPORT"
 class NodeReportTranslation(Translator):
     """Posts every NodeStatus seen on interprocess as a NODE_REPORT line."""
 
-    def __init__(self, cfg: GobyMOOSGatewayConfig) -> None:
-        super().__init__(cfg)
+    def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None) -> None:
+        super().__init__(cfg, index, comms_kind=comms_kind)
         self._geodesy = geodesy_from_config(cfg)
         self.goby().interprocess().subscribe(groups.node_status, NodeStatus, self._on_node_status)
 
