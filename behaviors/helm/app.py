@@ -76,6 +76,7 @@ class HelmApp:
 
     # ---- callbacks (MOOS client's I/O thread) ---------------------------------------------------
     def _on_connect(self) -> bool:
+        self.helm.registered_at = self.clock.time()
         for var in self._registrations:
             self.comms.register(var, 0)
         return True

@@ -60,6 +60,7 @@ class Helm:
         self.has_control = config.start_engaged
         self.state = "MALCONFIG" if self.problems else ("DRIVE" if self.has_control else "PARK")
         self.start_time: float | None = None
+        self.registered_at: float | None = None  # when the app last registered (on each connection)
         self.last_decisions: dict[str, float] = {}
         self._allstop = ""
         self._posted_state = ""
@@ -105,7 +106,10 @@ class Helm:
     def handle_mail(self, var: str, value: Value, msg_time: float, source: str, now: float) -> list[Post]:
         """One incoming message (in arrival order); returns anything it makes the helm post at once."""
         out: list[Post] = []
-        if source != self.app_name and self.config.ok_skew is not None and abs(now - msg_time) > self.config.ok_skew:
+        skew = abs(now - msg_time)
+        if self.registered_at is not None:  # a value the DB held from before we registered is not stale
+            skew = min(skew, abs(now - self.registered_at))
+        if source != self.app_name and self.config.ok_skew is not None and skew > self.config.ok_skew:
             out.append(Post("IVPHELM_SKEW", f"var={var},skew={fmt_num(now - msg_time, 2)},src={source}"))
             return out
         if var in OVERRIDE_VARS or (var and var == self.config.other_override_var):

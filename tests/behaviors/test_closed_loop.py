@@ -137,3 +137,20 @@ def test_malconfig_over_moos_names_the_file_line_and_token(tmp_path: Path) -> No
             assert warning.startswith(f"{bhv}:5: ") and "clockwise = sideways" in warning
             obs.wait_moos(5)
             assert obs.values("DESIRED_HEADING") == [] and obs.values("DESIRED_SPEED") == []
+
+
+def test_values_posted_long_before_the_helm_started_are_not_dropped_as_stale(tmp_path: Path) -> None:
+    """pHelmIvP's skew is min(message age, time since registering): a value the DB hands over is fresh."""
+    clock = MoosClock(WARP)
+    bhv = tmp_path / "survey.bhv"
+    bhv.write_text(SURVEY)
+    with running_moosdb("alpha", warp=WARP) as db, observer(db.port, clock, WATCH + ["IVPHELM_SKEW"]) as obs:
+        obs.post("DEPLOY", "true")
+        obs.post("MOOS_MANUAL_OVERRIDE", "false")
+        obs.wait_moos(90)  # older than ok_skew (60 s) by the time the helm registers
+        mission = write_mission(tmp_path, db.port, bhv)
+        (tmp_path / "survey.bhv").write_text(SURVEY.replace("initialize DEPLOY = false\n", ""))
+        with helm_process(mission, tmp_path), vehicle(db.port, clock, x=0, y=0, heading=0):
+            assert obs.wait(lambda: obs.last("IVPHELM_STATE") == "DRIVE"), (tmp_path / "helm.log").read_text()
+            assert obs.wait(lambda: obs.last("DESIRED_SPEED") == pytest.approx(2.0))
+        assert obs.values("IVPHELM_SKEW") == []

@@ -110,9 +110,15 @@ def test_another_helm_state_disables_this_helm(tmp_path: Path) -> None:
 def test_stale_mail_is_dropped_with_ivphelm_skew(tmp_path: Path) -> None:
     loop = CoreLoop(make_helm(tmp_path, FLAGS, start_engaged="true", ok_skew="30"), KinematicModel())
     loop.run(1)
+    loop.helm.registered_at = loop.t - 60
     loop._deliver(loop.helm.handle_mail("GO", "true", loop.t - 100, "uPokeDB", loop.t))
     loop.run(1)
     assert loop.values("RUN") == [] and loop.values("IVPHELM_SKEW")
+    # an old value the DB hands over right after registration is not stale (skew = time since registering)
+    loop.helm.registered_at = loop.t - 5
+    loop._deliver(loop.helm.handle_mail("GO", "true", loop.t - 100, "uPokeDB", loop.t))
+    loop.run(1)
+    assert loop.values("RUN") == ["hdg"]
 
 
 def test_alias_names_the_app_and_falls_back_to_the_phelmivp_block(tmp_path: Path) -> None:
