@@ -127,10 +127,11 @@ def child(role: str, client: str, port: int, name: str, var: str = "", count: in
 def sink_result(proc: subprocess.Popen[str]) -> dict[str, object]:
     out = proc.stdout.read()  # type: ignore[union-attr]  # same buffered reader that saw "ready"
     proc.wait(60)
-    lines = [line for line in out.splitlines() if line.startswith("{")]
+    # A C++ client may print text without a newline just before our JSON, so look for the JSON itself.
+    lines = ["{" + line.split("{", 1)[1] for line in out.splitlines() if '{"received"' in line]
     if not lines:
         tail = Path(proc.log_path).read_text(errors="replace")[-300:]  # type: ignore[attr-defined]
-        print(f"  a sink failed (exit {proc.returncode}): {tail!r}", file=sys.stderr)
+        print(f"  a sink failed (exit {proc.returncode}): {tail!r} {out[-300:]!r}", file=sys.stderr)
         return {"received": 0, "in_order": False, "first": 0.0, "last": 0.0}
     return json.loads(lines[-1])
 

@@ -8,6 +8,7 @@ their queue's own thread.
 from __future__ import annotations
 
 import logging
+import threading
 import time as _time
 
 from .active_queue import MessageCallback
@@ -165,6 +166,9 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
         (the registration is still remembered and applied on connect).
         """
         if len(args) == 2:
+            if not name or not args[0]:
+                log.warning("wildcard register needs a variable pattern and an app pattern")
+                return False
             return self._wildcard(WILDCARD_REGISTER, name, str(args[0]), float(args[1]))  # type: ignore[arg-type]
         if len(args) > 2:
             raise TypeError("register(name, interval=0) or register(var_pattern, app_pattern, interval)")
@@ -207,6 +211,8 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
         Replies (id -2) are taken out of the inbox; other mail stays for ``fetch``. The DB sends all replies
         to one request in one packet, so this returns as soon as they arrive (or ``[]`` after ``timeout``).
         """
+        if threading.get_ident() == self._io_ident:
+            raise MoosError("server_request() waits for the I/O thread, so it cannot run in a comms callback")
         msg = MoosMessage(SERVER_REQUEST, STRING, msg_id=SERVER_REQUEST_ID, key=to_bytes(what), msg_time=self._clock.time())
         if not self._post(msg, assign_id=False):
             return []
