@@ -11,6 +11,7 @@ import argparse
 import logging
 import signal
 import threading
+import time
 from pathlib import Path
 
 from gateway.logsetup import add_verbosity_argument, configure_logging
@@ -93,12 +94,12 @@ class HelmApp:
             return
         self._publish(self.helm.startup(self.clock.time()))
         period = 1.0 / (self.helm.config.app_tick * self.clock.warp)
-        next_tick = self.clock.time(apply_warp=False)
+        next_tick = time.monotonic()  # ticks are scheduled in real time: AppTick x warp per second
         while not self._stop.is_set():
-            self._wake.wait(max(0.0, next_tick - self.clock.time(apply_warp=False)))
+            self._wake.wait(max(0.0, next_tick - time.monotonic()))
             self._wake.clear()
             self._handle_mail()
-            now_real = self.clock.time(apply_warp=False)
+            now_real = time.monotonic()
             if now_real >= next_tick:
                 try:
                     self._publish(self.helm.iterate(self.clock.time()))
@@ -111,6 +112,7 @@ class HelmApp:
         now = self.clock.time()
         for msg in self.comms.fetch():
             if msg.is_binary():
+                log.debug("ignoring binary mail %s (no behaviour reads binary data)", msg.key())
                 continue
             value = msg.double() if msg.is_double() else msg.string()
             self._publish(self.helm.handle_mail(msg.key(), value, msg.time(), msg.source(), now))
