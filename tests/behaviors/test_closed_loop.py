@@ -58,10 +58,11 @@ def test_park_then_waypoints_in_order_within_capture_radius(tmp_path: Path) -> N
             obs.post("DEPLOY", "true")
             obs.post("MOOS_MANUAL_OVERRIDE", "false")
             assert obs.wait(lambda: obs.last("IVPHELM_STATE") == "DRIVE")
-            start = clock.time()
             assert obs.wait(lambda: obs.values("DONE"), timeout=90), obs.values("WPT_INDEX")
-            duration = clock.time() - start
         track = sim.track
+    # MOOS times stamped by the helm itself, so observer latency does not count
+    start = next(t for t, n, v, _ in obs.mail if n == "IVPHELM_STATE" and v == "DRIVE")
+    duration = next(t for t, n, _, _ in obs.mail if n == "DONE") - start
     assert obs.values("WPT_INDEX") == [0.0, 1.0, 2.0, 3.0]
     assert obs.values("ARRIVED") == ["40,0", "40,50", "-20,50", "-20,10"]
     assert obs.last("WPT_STAT") == "behavior-name=survey,completed"
@@ -116,13 +117,15 @@ def test_usv_deploy_state_switch_and_center_activate(tmp_path: Path) -> None:
             assert obs.wait(lambda: sim.model.x > 40, timeout=60)
             assert obs.last("WPT_INDEX") == 0.0
             obs.wait_moos(20)
-            here = (sim.model.x, sim.model.y)
+            posted_at = clock.time()
             obs.post("DEPLOY_STATE", "POLYGON")
             assert obs.wait(lambda: obs.last("IVPHELM_BHV_ACTIVE") == "polygon")
             assert obs.wait(lambda: polygon_center(str(obs.last("VIEW_POLYGON")))[0] > 30)
             cx, cy = polygon_center(str(obs.last("VIEW_POLYGON")))
-            # recentred on where the vehicle was when the loiter became active again
-            assert math.hypot(cx - here[0], cy - here[1]) < 15, ((cx, cy), here)
+            active_at = max(t for t, n, v, _ in obs.mail if n == "IVPHELM_BHV_ACTIVE" and v == "polygon")
+            # recentred on a position the vehicle had between the command and the loiter's activation
+            window = [(x, y) for t, x, y, _, _ in sim.track if posted_at - 2 <= t <= active_at + 1]
+            assert min(math.hypot(cx - x, cy - y) for x, y in window) < 2.0, ((cx, cy), window[:1], window[-1:])
 
 
 def test_malconfig_over_moos_names_the_file_line_and_token(tmp_path: Path) -> None:
