@@ -125,18 +125,24 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
         Forms, as pymoos: ``notify(name, value)``, ``notify(name, value, time)``, ``notify(name, value, aux)``,
         ``notify(name, value, aux, time)``. ``time=-1`` means now (MOOS time). False if not connected.
         """
-        aux: str = ""
-        if len(args) == 1:
-            if isinstance(args[0], str):
-                aux = args[0]
+        aux = b""
+        if args:
+            if len(args) == 1:
+                if isinstance(args[0], str):
+                    aux = to_bytes(args[0])
+                else:
+                    time = float(args[0])  # type: ignore[arg-type]
+            elif len(args) == 2:
+                aux, time = to_bytes(str(args[0])), float(args[1])  # type: ignore[arg-type]
             else:
-                time = float(args[0])  # type: ignore[arg-type]
-        elif len(args) == 2:
-            aux, time = str(args[0]), float(args[1])  # type: ignore[arg-type]
-        elif args:
-            raise TypeError("notify(name, value[, aux_src][, time])")
+                raise TypeError("notify(name, value[, aux_src][, time])")
         if time == -1.0:
             time = self._clock.time()
+        self._published.add(name)
+        key = self._keys.get(name) or self._key(name)
+        kind = type(value)
+        if kind is float or kind is int:
+            return self._post_fields(NOTIFY, DOUBLE, key, aux, time, float(value), b"")
         if isinstance(value, str | bytes | bytearray):
             raw = to_bytes(value) if isinstance(value, str) else bytes(value)
             cut = raw.find(b"\0")
@@ -144,11 +150,8 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
                 log.warning("notify %s: string value truncated at its first NUL byte, as MOOS does; "
                             "use notify_binary for arbitrary bytes", name)
                 raw = raw[:cut]
-            msg = MoosMessage(NOTIFY, STRING, -1, b"", to_bytes(aux), b"", self._key(name), time, -1.0, -1.0, raw)
-        else:
-            msg = MoosMessage(NOTIFY, DOUBLE, -1, b"", to_bytes(aux), b"", self._key(name), time, float(value))
-        self._published.add(name)
-        return self._post(msg)
+            return self._post_fields(NOTIFY, STRING, key, aux, time, -1.0, raw)
+        return self._post_fields(NOTIFY, DOUBLE, key, aux, time, float(value), b"")  # bool, numpy, Decimal...
 
     def notify_binary(self, name: str, binary_data: bytes | str, time: float = -1.0) -> bool:
         """Publish raw bytes as a BINARY message (the only way to send arbitrary bytes, including NUL)."""

@@ -58,16 +58,26 @@ def _head_struct(n_src: int, n_aux: int, n_com: int, n_key: int) -> Struct:
     return compiled
 
 
-def encode_message(msg: MoosMessage) -> bytes:
-    """Serialise one message exactly as ``CMOOSMsg::Serialize`` does (one struct pack plus the payload)."""
-    src, aux, com, key, sval = msg.raw_src, msg.raw_aux, msg.raw_community, msg.raw_key, msg.raw_sval
-    n_src, n_aux, n_com, n_key, n_sval = len(src), len(aux), len(com), len(key), len(sval)
+def encode_fields(
+    msg_type: bytes, data_type: bytes, msg_id: int, src: bytes, aux: bytes, com: bytes, key: bytes,
+    msg_time: float, dval: float, dval2: float, sval: bytes,
+) -> bytes:
+    """Serialise one message from its fields (no MoosMessage needed): one struct pack plus the payload."""
+    n_src, n_aux, n_com, n_key = len(src), len(aux), len(com), len(key)
     lengths = (n_src, n_aux, n_com, n_key)
     head = _head_structs.get(lengths) or _head_struct(*lengths)
     return head.pack(
-        54 + n_src + n_aux + n_com + n_key + n_sval, msg.msg_id, msg.msg_type, msg.data_type,
-        n_src, src, n_aux, aux, n_com, com, n_key, key, msg.msg_time, msg.dval, msg.dval2, n_sval,
+        head.size + len(sval), msg_id, msg_type, data_type,
+        n_src, src, n_aux, aux, n_com, com, n_key, key, msg_time, dval, dval2, len(sval),
     ) + sval
+
+
+def encode_message(msg: MoosMessage) -> bytes:
+    """Serialise one message exactly as ``CMOOSMsg::Serialize`` does."""
+    return encode_fields(
+        msg.msg_type, msg.data_type, msg.msg_id, msg.raw_src, msg.raw_aux, msg.raw_community, msg.raw_key,
+        msg.msg_time, msg.dval, msg.dval2, msg.raw_sval,
+    )
 
 
 def frame_packet(encoded_messages: list[bytes]) -> bytes:

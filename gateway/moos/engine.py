@@ -22,7 +22,7 @@ from collections.abc import Callable
 
 from .active_queue import ActiveQueueRouter
 from .clock import DEFAULT_CLOCK, MoosClock
-from .codec import encode_message, frame_packet
+from .codec import encode_fields, encode_message, frame_packet
 from .connection import PacketSocket, Welcome, client_handshake, open_socket
 from .errors import ConnectionClosedError, HandshakeError, MoosError, PoisonedError, ProtocolError
 from .message import DOUBLE, NOTIFY, NULL_MSG, TIMING, TIMING_KEY, MoosMessage, to_bytes
@@ -146,18 +146,29 @@ class ClientEngine:
         return raw
 
     def _post(self, msg: MoosMessage, assign_id: bool = True) -> bool:
-        """Queue ``msg`` (encoded at once) and get it written: directly if the link is idle, else by the writer."""
-        msg.raw_src = self._src
+        """Queue ``msg`` with our name as its source (and the next id unless told otherwise)."""
+        return self._post_fields(
+            msg.msg_type, msg.data_type, msg.raw_key, msg.raw_aux, msg.msg_time, msg.dval, msg.raw_sval,
+            None if assign_id else msg.msg_id,
+        )
+
+    def _post_fields(
+        self, msg_type: bytes, data_type: bytes, key: bytes, aux: bytes, msg_time: float, dval: float,
+        sval: bytes, msg_id: int | None = None,
+    ) -> bool:
+        """Encode a message at once and get it written: directly if the link is idle, else by the writer."""
         on_io_thread = threading.get_ident() == self._io_ident
         with self._lock:
             if not self._live:
                 return False
-            if assign_id:
-                msg.msg_id = self._next_id
+            if msg_id is None:
+                msg_id = self._next_id
                 self._next_id += 1
             if not on_io_thread and len(self._outbox) >= self._outbox_limit:
                 self._wait_for_space()
-            self._outbox.append(encode_message(msg))
+            self._outbox.append(
+                encode_fields(msg_type, data_type, msg_id, self._src, aux, b"", key, msg_time, dval, -1.0, sval)
+            )
             direct = (
                 self._async
                 and not self._busy
