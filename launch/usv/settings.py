@@ -81,9 +81,9 @@ class UsvSettings:
         """Sim seconds without a helm report or frontseat data before the interface calls it an error.
 
         The course uses 10; at warp 20 that is half a real second, less than a Python process needs to start
-        or than a busy machine may delay one message, so it grows with the warp (two real seconds).
+        or than a busy machine may delay one message, so it grows with the warp (three real seconds).
         """
-        return max(10, 2 * self.warp)
+        return max(10, 3 * self.warp)
 
     @property
     def moos_file(self) -> Path:

@@ -55,9 +55,9 @@ def test_frontseat_and_gateway_point_at_the_same_moosdb_and_simulator(settings):
     assert helm.port == gw.moos.port == 9123
     assert sim.tcp_port == int(generate("frontseat_sim", settings)) == 55123
     assert (sim.start.lat, sim.start.lon) == (41.5, -70.7)
-    # the course's 10 s, stretched to two real seconds at this warp
-    assert fs.frontseat_cfg.helm_running_timeout == fs.frontseat_cfg.frontseat_connected_timeout == 34
-    assert sim.data_timeout == 34
+    # the course's 10 s, stretched to three real seconds at this warp
+    assert fs.frontseat_cfg.helm_running_timeout == fs.frontseat_cfg.frontseat_connected_timeout == 51
+    assert sim.data_timeout == 51
 
 
 def test_moos_file_matches_the_goby_side(settings):
