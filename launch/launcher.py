@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import shlex
 import signal
 import sys
 import time
@@ -25,6 +26,7 @@ from launch.process_group import ProcessGroup
 
 log = logging.getLogger(__name__)
 
+PRESEED = "preseed.goby"  # sourced before each command when it sits next to the launch file, as goby_launch does
 _UNSUPPORTED_MODES = {
     "screen": "-s (GNU screen)",
     "nohup": "-n (nohup)",
@@ -110,6 +112,11 @@ def main(argv: list[str] | None = None) -> int:
         base_env=child_environment(),
         parallel_stop=args.parallel,
     )
+    preseed = Path(args.launchfile).resolve().parent / PRESEED
+    preamble = f"source {shlex.quote(str(preseed))} || exit 1" if preseed.is_file() else ""
+    if preamble:
+        print(f"Sourcing {preseed} before each command", flush=True)
+    group.preamble = preamble
     print(f"Logs in {log_dir}", flush=True)
     with stop_on_signals(group):
         try:

@@ -100,6 +100,7 @@ class ProcessGroup:
         parallel_stop: bool = False,
         report: Reporter = _print,
         on_wait: Callable[[], None] | None = None,
+        preamble: str = "",
     ) -> None:
         if not entries:
             raise LaunchError("nothing to launch: the launch file has no commands")
@@ -115,6 +116,8 @@ class ProcessGroup:
         self.report = report
         # Called on the starting thread while start() waits between launches (e.g. to read mail meanwhile).
         self.on_wait = on_wait
+        # Shell run before each command (goby_launch sources a preseed.goby found next to the launch file).
+        self.preamble = preamble
         self.processes: list[ManagedProcess] = []
         self.stop_event = threading.Event()
         self._named_once = False
@@ -140,6 +143,8 @@ class ProcessGroup:
         log_file = open(log_path, "wb")  # closed when the process is reaped
         # `exec` makes the program itself the pid we signal; bash cannot exec an assignment prefix.
         script = entry.command if _ASSIGNMENT.match(entry.command) else f"exec {entry.command}"
+        if self.preamble:
+            script = f"{self.preamble}\n{script}"
         try:
             popen = subprocess.Popen(
                 ["/bin/bash", "-c", script],

@@ -200,3 +200,16 @@ def test_a_process_that_finishes_with_status_zero_is_not_a_failure(tmp_path):
     assert run.proc.returncode == 0, output
     assert "oneshot finished" in output
     assert "All processes exited" in output
+
+
+def test_preseed_next_to_the_launch_file_is_sourced_for_every_command(tmp_path):
+    (tmp_path / "preseed.goby").write_text("export FROM_PRESEED=seeded\n")
+    launch_file = tmp_path / "seeded.launch"
+    launch_file.write_text("[name=one] bash -c 'echo one=$FROM_PRESEED'\n[name=two] bash -c 'echo two=$FROM_PRESEED'\n")
+    logs = tmp_path / "logs"
+    run = LauncherRun(launch_file, logs)
+    output = run.finish()
+    assert run.proc.returncode == 0, output
+    assert "Sourcing" in output
+    assert "one=seeded" in (logs / "one.log").read_text()
+    assert "two=seeded" in (logs / "two.log").read_text()
