@@ -40,6 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--duration", type=float, default=DEFAULT_DURATION_S,
                         help=f"sim seconds to run after the helm takes command (default {DEFAULT_DURATION_S:g}; "
                         "0 = until Ctrl-C)")
+    parser.add_argument("--forever", action="store_true", help="run until Ctrl-C or SIGTERM (same as --duration 0)")
     parser.add_argument("--warp", type=int, default=DEFAULT_WARP, help=f"time warp (default {DEFAULT_WARP})")
     parser.add_argument("--out", type=Path, default=Path("out"), help="output directory (default ./out)")
     parser.add_argument("--moosdb", choices=("auto", "real", "ours"), default="auto",
@@ -102,7 +103,7 @@ def run_demo(args: argparse.Namespace) -> int:
         shutil.rmtree(run_dir)
     socket_dir = run_dir if len(str(run_dir)) < MAX_SOCKET_BASE else Path(tempfile.mkdtemp(prefix="usv-", dir="/tmp"))
     settings = make_settings(args, run_dir, socket_dir)
-    duration = args.duration if args.duration > 0 else None
+    duration = args.duration if args.duration > 0 and not args.forever else None
     print(f"USV mission: {settings.moosdb}, {settings.helm}, warp {settings.warp}, MOOS port {settings.moos_port}, "
           f"simulator port {settings.sim_port}; logs in {settings.log_dir}", flush=True)
     mission = UsvMission(settings)

@@ -96,7 +96,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
 def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(tmp_path):
     out_dir = tmp_path / "o"
     proc = subprocess.Popen(
-        [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--duration", "0", "--warp", "20",
+        [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--forever", "--warp", "20",
          "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_tcp_port()),
          "--sim-port", str(free_tcp_port())],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
