@@ -94,7 +94,8 @@ def worker(args: argparse.Namespace) -> int:
             last = now
         if batch:
             last_activity = time.monotonic()
-    print(json.dumps({"received": received, "in_order": in_order, "first": first, "last": last}), flush=True)
+    print(json.dumps({"received": received, "in_order": in_order, "first": first, "last": last,
+                      "cpu": time.process_time()}), flush=True)
     comms.close(True)
     return 0
 

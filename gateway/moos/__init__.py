@@ -14,7 +14,6 @@ from .errors import (
     HandshakeError,
     MissionFileError,
     MoosError,
-    NotConnectedError,
     PoisonedError,
     ProtocolError,
 )
@@ -61,7 +60,6 @@ __all__ = [
     "MoosClock",
     "MoosError",
     "MoosMessage",
-    "NotConnectedError",
     "PoisonedError",
     "ProtocolError",
     "comms",

@@ -101,7 +101,8 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
         return self._queues.add_route(queue_name, to_bytes(msg_name))
 
     def add_wildcard_active_queue(self, queue_name: str, pattern: str, func: MessageCallback) -> bool:
-        """Create (if needed) a queue for every notification whose name matches the MOOS wildcard ``pattern``."""
+        """Route every notification whose name matches the MOOS wildcard ``pattern`` to queue ``queue_name``
+        (created if needed); ``func(msg)`` runs on the queue's own thread."""
         if not self._queues.has_queue(queue_name):
             self._queues.add_queue(queue_name, func)
         return self._queues.add_route(queue_name, to_bytes(pattern), wildcard=True)

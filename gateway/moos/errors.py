@@ -25,9 +25,5 @@ class ConnectionClosedError(MoosError):
     """The peer closed the connection, or the connection was closed locally."""
 
 
-class NotConnectedError(MoosError):
-    """An operation needs a live connection to a MOOSDB and there is none."""
-
-
 class MissionFileError(MoosError):
     """A ``.moos`` mission file cannot be read or is malformed."""
