@@ -20,6 +20,19 @@ def format_g15(value: float) -> str:
     return f"{value:.15g}"
 
 
+def format_report_number(value: float) -> str:
+    """A NODE_REPORT number: rounded to 1e-3 and printed like ``%.15g``, but never in exponent form.
+
+    pHelmIvP's report parser rejects the whole report when a number reads ``-9.3e-10`` (as ``%.15g`` prints a
+    y of almost zero); the course never hit this because its values were DCCL-quantized to 0.1 m / 1 degree.
+    """
+    rounded = round(value, 3) + 0.0  # + 0.0 turns -0.0 into 0.0
+    text = f"{rounded:.15g}"
+    if "e" in text:  # only for |value| >= 1e15 after rounding
+        text = f"{rounded:.3f}".rstrip("0").rstrip(".")
+    return text
+
+
 def local_xy(status: NodeStatus, geodesy: UTMGeodesy | None) -> tuple[float, float]:
     """(x, y) metres of a NodeStatus on the local grid.
 
@@ -89,21 +102,22 @@ def node_report(status: NodeStatus, geodesy: UTMGeodesy | None = None, name: str
     """A NODE_REPORT line in the Goby3 course's format, which pHelmIvP's contact parser accepts.
 
     ``NAME=..,TYPE=..,TIME=..,X=..,Y=..,DEPTH=..,HDG=..,SPD=..``; every number is printed with 15 significant
-    digits because the course sets the stream precision just before TIME and it sticks. HDG is normalised to
-    [0, 360) as the course's nav conversion does. NAME is ``name`` if given, else the status's name, else its
+    digits because the course sets the stream precision just before TIME and it sticks; X, Y, DEPTH, HDG and SPD
+    are first rounded to 1e-3 so that they never print in exponent form (see :func:`format_report_number`).
+    HDG is normalised to [0, 360) as the course's nav conversion does. NAME is ``name`` if given, else the status's name, else its
     type name.
     """
     x, y = local_xy(status, geodesy)
     vehicle_name = name or status.name or vehicle_type_name(status)
-    heading = normalized_heading(status.pose.heading)
+    heading = normalized_heading(round(normalized_heading(status.pose.heading), 3))  # 359.9999 -> 0, not 360
     fields = [
         ("NAME", vehicle_name),
         ("TYPE", vehicle_type_name(status)),
         ("TIME", format_g15(status.time)),
-        ("X", format_g15(x)),
-        ("Y", format_g15(y)),
-        ("DEPTH", format_g15(status.global_fix.depth)),
-        ("HDG", format_g15(heading)),
-        ("SPD", format_g15(status.speed.over_ground)),
+        ("X", format_report_number(x)),
+        ("Y", format_report_number(y)),
+        ("DEPTH", format_report_number(status.global_fix.depth)),
+        ("HDG", format_report_number(heading)),
+        ("SPD", format_report_number(status.speed.over_ground)),
     ]
     return ",".join(f"{key}={value}" for key, value in fields)

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus, Source
 from gateway.geodesy import UTMGeodesy
-from translators.nav_conversion import format_g15, nav_posts, node_report
+from translators.nav_conversion import format_g15, format_report_number, nav_posts, node_report
 
 # ivp_helm.md §7.3: origin 43.8253, -70.3304 (zone 19T); (x, y) <-> (lat, lon) from pyproj/PROJ and a Gantz port.
 ORIGIN = (43.8253, -70.3304)
@@ -148,4 +148,20 @@ def test_node_report_heading_is_always_in_0_360(heading):
     status = make_status(43.8, -70.3, pose__heading=heading)
     hdg = float(dict(item.split("=", 1) for item in node_report(status).split(","))["HDG"])
     assert 0.0 <= hdg < 360.0
-    assert math.isclose(math.cos(math.radians(hdg)), math.cos(math.radians(heading)), abs_tol=1e-9)
+    difference = (hdg - heading) % 360.0
+    assert min(difference, 360.0 - difference) <= 0.0005 + 1e-9  # the same direction, to the 1e-3 printed
+
+
+@pytest.mark.parametrize(
+    ("value", "text"),
+    [(-9.31322574615479e-10, "0"), (200.000000000407, "200"), (-0.0, "0"), (1.25, "1.25"), (-40.0001234, "-40"),
+     (12.3456, "12.346"), (1e20, "100000000000000000000")],
+)
+def test_report_numbers_never_use_exponents(value, text):
+    """pHelmIvP drops a whole NODE_REPORT whose number reads like -9.3e-10 (checked against the real helm)."""
+    assert format_report_number(value) == text
+
+
+def test_heading_just_below_360_reports_0():
+    status = make_status(43.8, -70.3, pose__heading=359.99995)
+    assert ",HDG=0," in node_report(status)
