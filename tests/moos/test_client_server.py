@@ -291,3 +291,25 @@ def test_idle_async_client_stays_alive_on_timing_messages() -> None:
             qos = collect_mail(idler, ["DB_QOS"], until=lambda ms: bool(poker.notify("P", 1.0)) and bool(ms),
                                timeout=10)
         assert "idler=" in qos[-1].string()
+
+
+def test_warped_db_publishes_warped_time() -> None:
+    """MOOSTimeWarp multiplies absolute unix time, for the DB's DB_TIME as for client stamps."""
+    from gateway.moos.testing import running_moosdb
+
+    with running_moosdb(warp=10.0) as db:
+        clock = MoosClock(10.0)
+        client = comms(clock=clock)
+        client.set_on_connect_callback(lambda: client.register("DB_TIME", 0))
+        client.run("127.0.0.1", db.port, "warp10")
+        try:
+            assert client.wait_until_connected(10_000)
+            assert client.welcome is not None and abs(client.welcome.skew) < 5.0  # same warp: tiny skew
+            got: list[MoosMessage] = []
+            deadline = time.monotonic() + 10
+            while not got and time.monotonic() < deadline:
+                client.notify("TICK", 1.0)  # 2 s of DB time pass in 0.2 s of real time
+                got = collect_mail(client, ["DB_TIME"], until=1, timeout=0.2)
+            assert got and got[0].double() == pytest.approx(time.time() * 10.0, rel=1e-6)
+        finally:
+            client.close()

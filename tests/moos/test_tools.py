@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -116,3 +117,20 @@ def test_console_scripts_run(tmp_path: Path) -> None:
         run = subprocess.run([str(BIN / "moos-scope"), "CS_X", "--once", f"--port={db.port}"], capture_output=True,
                              text=True, timeout=30)
         assert run.returncode == 0 and "uPokeDB" in run.stdout
+
+
+def test_moos_db_timeout_flag_drops_silent_clients(tmp_path: Path) -> None:
+    import socket
+
+    from gateway.moos.codec import PROTOCOL_BYTES, encode_packet
+    from gateway.moos.message import DATA, STRING, MoosMessage
+
+    with MoosDBProcess(tmp_path, extra_args=["--moos_timeout=1"]) as db:
+        with socket.create_connection(("127.0.0.1", db.port), timeout=10) as sock:
+            hello = MoosMessage(DATA, STRING, key=b"asynchronous", msg_time=1.0, sval=b"mute")
+            sock.sendall(PROTOCOL_BYTES + encode_packet([hello]))
+            start = time.monotonic()
+            while sock.recv(4096):  # the WELCOME, then nothing until the DB hangs up
+                pass
+            assert 0.5 < time.monotonic() - start < 8
+        assert "seconds of silence" in db.log_path.read_text()
