@@ -178,3 +178,50 @@ def _garbage_then_valid(broker: BrokerProcess) -> None:
         req.close()
         pub, _, _ = request_endpoints(zctx, broker.interprocess_config(), "after_garbage", timeout_s=10)
     assert pub.endswith(".xsub")
+
+
+def test_a_goby_style_raw_client_completes_the_hold_handshake(tmp_path: Path) -> None:
+    """What a C++ Goby3 client does (spec §4.7), in raw ZeroMQ: sockets over REQ, hold over pub/sub."""
+    from gateway.protobuf.interprocess_zeromq_pb2 import ManagerResponse
+
+    hold = ["--hold", 'required_client: "goby_app"']
+    with broker_process(tmp_path, platform="raw_goby", extra_args=hold) as broker, zmq.Context() as zctx:
+        req = zctx.socket(zmq.REQ)
+        req.setsockopt(zmq.LINGER, 0)
+        req.connect(f"ipc://{broker.socket_base}.manager")
+        req.send(ManagerRequest(request=PROVIDE_PUB_SUB_SOCKETS, client_name="goby_app", client_pid=4242)
+                 .SerializeToString())
+        assert req.poll(10_000)
+        sockets = ManagerResponse.FromString(req.recv())
+        req.close()
+        sub = zctx.socket(zmq.SUB)
+        pub = zctx.socket(zmq.PUB)
+        for sock in (sub, pub):
+            sock.setsockopt(zmq.LINGER, 0)
+        sub.connect(f"ipc://{sockets.subscribe_socket.socket_name}")
+        pub.connect(f"ipc://{sockets.publish_socket.socket_name}")
+        response_prefix = b"/goby::zeromq::_internal_manager_response/PROTOBUF/goby.zeromq.protobuf.ManagerResponse/"
+        sub.setsockopt(zmq.SUBSCRIBE, response_prefix)
+        request_ident = b"/goby::zeromq::_internal_manager_request/PROTOBUF/goby.zeromq.protobuf.ManagerRequest/4242/1f/"
+        def hold_answers(ready: bool, until_released: bool) -> list[bool]:
+            answers: list[bool] = []
+            for _ in range(100):  # every 100 ms, as Goby does while held
+                request = ManagerRequest(request=PROVIDE_HOLD_STATE, client_name="goby_app", client_pid=4242,
+                                         ready=ready)
+                pub.send(request_ident + b"\0" + request.SerializeToString())
+                while sub.poll(100):
+                    frame = sub.recv()
+                    assert frame.startswith(response_prefix)
+                    response = ManagerResponse.FromString(frame[frame.index(b"\0") + 1:])
+                    assert (response.client_name, response.client_pid) == ("goby_app", 4242)
+                    answers.append(response.hold)
+                if answers and (not until_released or answers[-1] is False):
+                    return answers
+            return answers
+
+        not_ready = hold_answers(False, until_released=False)
+        ready = hold_answers(True, until_released=True)
+        sub.close()
+        pub.close()
+    assert not_ready and all(not_ready)  # held while the required client is not ready
+    assert ready and ready[-1] is False  # released once it reports ready
