@@ -27,6 +27,7 @@ from gateway.portal.errors import ClosedError, IdentifierError, MarshallingError
 from gateway.portal.group import GroupLike, as_group, check_named
 from gateway.portal.identifier import (
     EVERYTHING,
+    Identifier,
     decode_frame,
     encode_frame,
     make_identifier,
@@ -48,6 +49,7 @@ HOLD_REQUEST_PERIOD_S = 0.1
 #: How long ``publish`` waits for room when the PUB queue toward the broker is full before dropping (logged).
 SEND_BLOCK_S = 1.0
 RECV_BATCH = 512
+HEAD_CACHE_SIZE = 4096  # distinct identifiers remembered as already validated
 
 RegexCallback = Callable[[bytes, int, str, str], None]
 
@@ -86,6 +88,7 @@ class InterProcessPortal:
         self._identifiers: dict[tuple[str, int, str], str] = {}
         self._groups: dict[GroupLike, str] = {}
         self._types: dict[tuple[type, int | None], tuple[int, str, str]] = {}
+        self._heads: dict[bytes, tuple[Identifier, bytes]] = {}
         self._closed = False
         self.dropped = 0
         self.malformed = 0
@@ -368,24 +371,25 @@ class InterProcessPortal:
 
     def _dispatch(self, frame: bytes) -> None:
         nul = frame.find(b"\0")
-        head = frame[:nul] if nul >= 0 else frame
-        # "/group/scheme/type/" is the head up to (and including) its fourth '/'
-        cut = -1
-        for _ in range(4):
-            cut = head.find(b"/", cut + 1)
-            if cut < 0:
-                break
-        prefix = head[: cut + 1] if cut >= 0 else b""
-        subs = self._subs.get(prefix) if nul >= 0 and cut >= 0 else None
-        if not subs and not self._regex and prefix != self._hold_response_prefix:
-            if nul < 0 or cut < 0:
-                self._malformed(frame, "frame has no /group/scheme/type/ identifier followed by NUL")
+        if nul < 0:
+            self._malformed(frame, "frame has no /group/scheme/type/pid/thread/ identifier followed by NUL")
             return
-        try:
-            ident, payload = decode_frame(frame)
-        except IdentifierError as exc:
-            self._malformed(frame, str(exc))
-            return
+        head = frame[:nul]
+        known = self._heads.get(head)
+        if known is None:  # first frame from this (group, scheme, type, process, thread): validate it once
+            try:
+                ident, _ = decode_frame(frame)
+            except IdentifierError as exc:
+                self._malformed(frame, str(exc))
+                return
+            cut = head.find(b"/", head.find(b"/", head.find(b"/", 1) + 1) + 1)  # fourth '/'
+            known = (ident, head[: cut + 1])
+            if len(self._heads) >= HEAD_CACHE_SIZE:
+                self._heads.clear()
+            self._heads[head] = known
+        ident, prefix = known
+        payload = frame[nul + 1:]
+        subs = self._subs.get(prefix)
         if prefix == self._hold_response_prefix and self._primary:
             self._on_manager_response(payload)
         if subs:
