@@ -146,6 +146,26 @@ def call_soon_latency(n: int) -> tuple[float, float]:
     return statistics.median(samples) * 1e6, samples[int(len(samples) * 0.99) - 1] * 1e6
 
 
+def in_process_costs(client: PortalClient, n: int) -> tuple[float, float]:
+    """(publish µs, receive-dispatch µs) per small message, measured in this process without the network."""
+    from gateway.portal.identifier import encode_frame, make_identifier
+
+    received: list[Sample] = []
+    client.subscribe("bench_local", Sample, received.append)
+    msg = Sample(a=1, temperature=2.0)
+    start = time.perf_counter()
+    for _ in range(n):
+        client.publish("bench_unsubscribed", msg)
+    publish_us = (time.perf_counter() - start) / n * 1e6
+    frame = encode_frame(make_identifier("bench_local", 1, Sample.DESCRIPTOR.full_name), msg.SerializeToString())
+    start = time.perf_counter()
+    for _ in range(n):
+        client.portal._dispatch(frame)  # the receive path after the socket read
+    dispatch_us = (time.perf_counter() - start) / n * 1e6
+    assert len(received) == n
+    return publish_us, dispatch_us
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--child", help=argparse.SUPPRESS)
@@ -176,6 +196,9 @@ def main(argv: list[str] | None = None) -> int:
             _, lost, published = bench.throughput(n_small, 0, None)
             rows.append(("blast small, no window", f"{published:,.0f} msg/s published", f"lost {lost}",
                          f"n={n_small}; past the HWM (1000+1000) the broker drops for the slow subscriber"))
+            pub_us, dispatch_us = in_process_costs(client, n_lat * 4)
+            rows.append(("in-process cost per small message", f"publish {pub_us:.1f} µs",
+                         f"dispatch {dispatch_us:.1f} µs", f"n={n_lat * 4}"))
             med, p99 = call_soon_latency(n_lat // 2)
             rows.append(("call_soon wake-up (same process)", f"median {med:.0f} µs", f"p99 {p99:.0f} µs",
                          f"n={n_lat // 2}"))
