@@ -35,8 +35,10 @@ class Waker:
 
     def __init__(self) -> None:
         self.event = threading.Event()
+        self.stamp = 0.0  # when the client announced mail (for the mail → fetch latency)
 
     def __call__(self) -> bool:
+        self.stamp = time.perf_counter()
         self.event.set()
         return True
 
@@ -142,6 +144,7 @@ def round_trip(kind: str, port: int, n: int, warmup: int) -> dict[str, float]:
     with child("echo", kind, port, "bench_echo", seconds=120):
         comms, waker = connect(kind, port, "bench_ping", ["PONG"])
         samples = []
+        handoffs = []
         try:
             for i in range(warmup + n):
                 waker.event.clear()
@@ -152,14 +155,18 @@ def round_trip(kind: str, port: int, n: int, warmup: int) -> dict[str, float]:
                     if not waker.event.wait(5):
                         raise RuntimeError(f"no PONG for ping {i}")
                     waker.event.clear()
-                    got = any(m.key() == "PONG" and m.double() == float(i) for m in comms.fetch())
+                    mail = comms.fetch()
+                    fetched = time.perf_counter()
+                    got = any(m.key() == "PONG" and m.double() == float(i) for m in mail)
                 if i >= warmup:
                     samples.append(time.perf_counter() - start)
+                    handoffs.append(fetched - waker.stamp)
             comms.notify("PING", -1.0)
         finally:
             comms.close(True)
     samples.sort()
-    return {"median_us": statistics.median(samples) * 1e6, "p99_us": samples[int(len(samples) * 0.99)] * 1e6}
+    return {"median_us": statistics.median(samples) * 1e6, "p99_us": samples[int(len(samples) * 0.99)] * 1e6,
+            "handoff_us": statistics.median(handoffs) * 1e6}
 
 
 def one_way(kind: str, port: int, n: int, subscribers: int = 1, payload: str | None = None) -> dict[str, float]:
@@ -258,7 +265,7 @@ def run_suite(db_kind: str, client_kind: str, quick: bool) -> dict[str, object]:
 
 
 def print_table(rows: list[dict[str, object]]) -> None:
-    head = (f"{'DB':<7} {'client':<7} {'rtt med':>8} {'rtt p99':>8} {'dbl/s':>9} {'lost':>6} {'1KiB/s':>8} "
+    head = (f"{'DB':<7} {'client':<7} {'rtt med':>8} {'rtt p99':>8} {'mail→fetch':>10} {'dbl/s':>9} {'lost':>6} {'1KiB/s':>8} "
             f"{'lost':>5} {'1→8 del/s':>10} {'lost':>6} {'order':>5} {'srv cpu':>7} {'srv MiB':>7}")
     print(head)
     print("-" * len(head))
@@ -266,9 +273,11 @@ def print_table(rows: list[dict[str, object]]) -> None:
         d, s, f = r["doubles"], r["strings"], r["fan"]
         order = "ok" if d["in_order"] and s["in_order"] and f["in_order"] else "BAD"
         print(f"{r['db']:<7} {r['client']:<7} {r['rtt']['median_us']:>6.0f}us {r['rtt']['p99_us']:>6.0f}us "
+              f"{r['rtt']['handoff_us']:>8.0f}us "
               f"{d['rate']:>9.0f} {d['lost']:>6} {s['rate']:>8.0f} {s['lost']:>5} {f['rate']:>10.0f} {f['lost']:>6} "
               f"{order:>5} {r['server_cpu_pct']:>6.0f}% {r['server_peak_mib']:>7.1f}")
-    print("rtt: A notifies, B echoes, A receives (median, p99). dbl/s: 50,000 doubles one way, unpaced, send start"
+    print("rtt: A notifies, B echoes, A receives (median, p99). mail→fetch: from the on-mail callback (client's"
+          " thread) to fetch() returning on the owner thread (median). dbl/s: 50,000 doubles one way, unpaced, send start"
           " to last receipt; lost = never received. 1→8: deliveries/s to 8 subscriber processes.")
 
 
