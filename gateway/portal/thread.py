@@ -162,7 +162,9 @@ class SimpleThread:
             self.finalize()
 
     def _after_initialize(self) -> None:
-        """Hook for applications (they report ``ready`` to the manager here)."""
+        """Report ``ready`` to the manager when this thread runs its own process context (applications too)."""
+        if self._owns_context and self._transports.has_interprocess:
+            self.interprocess().ready()
 
     # ---------------------------------------------------------------------------------- shutdown
     def close(self) -> None:
