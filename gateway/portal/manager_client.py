@@ -29,7 +29,10 @@ def request_endpoints(
     req = zctx.socket(zmq.REQ)
     req.setsockopt(zmq.LINGER, 0)
     try:
-        req.connect(endpoint)
+        try:
+            req.connect(endpoint)
+        except zmq.ZMQError as exc:
+            raise BrokerUnavailableError(f"cannot connect to the broker's manager at {endpoint}: {exc}") from exc
         req.send(request.SerializeToString())
         if not req.poll(int(timeout * 1000)):
             raise BrokerUnavailableError(

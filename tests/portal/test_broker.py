@@ -126,6 +126,12 @@ def test_no_broker_is_a_named_error(tmp_path: Path) -> None:
         PortalClient(cfg, "lonely")
 
 
+def test_unusable_socket_path_is_a_named_error(tmp_path: Path) -> None:
+    cfg = InterProcessPortalConfig(socket_name="/tmp/" + "x" * 200, manager_timeout_seconds=1)
+    with pytest.raises(BrokerUnavailableError, match="cannot connect to the broker's manager at ipc:///tmp/xxx"):
+        PortalClient(cfg, "long_path")
+
+
 def test_tcp_transport_end_to_end(tmp_path: Path) -> None:
     with broker_process(tmp_path, platform="tcp1", tcp=True) as tcp_broker:
         cfg = tcp_broker.interprocess_config()
