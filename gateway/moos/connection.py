@@ -124,7 +124,10 @@ def client_handshake(
     conn: PacketSocket, name: str, asynchronous: bool, clock: MoosClock, timeout: float = HANDSHAKE_TIMEOUT_S
 ) -> Welcome:
     """Send the protocol string and our name; return the DB's WELCOME or raise (POISON is PoisonedError)."""
-    hello = MoosMessage(DATA, STRING, key=ASYNC_KEY if asynchronous else b"", msg_time=clock.time(), sval=to_bytes(name))
+    # Stamped without skew, as libMOOS resets its skew before the handshake: the DB's reply measures it anew.
+    hello = MoosMessage(
+        DATA, STRING, key=ASYNC_KEY if asynchronous else b"", msg_time=clock.local_time(), sval=to_bytes(name)
+    )
     conn.sock.settimeout(timeout)
     try:
         conn.send(PROTOCOL_BYTES + encode_packet([hello]))

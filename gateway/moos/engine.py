@@ -95,7 +95,6 @@ class ClientEngine:
         self._fatal: MoosError | None = None
         self.welcome: Welcome | None = None  # the DB's last WELCOME (community, skew, DB time, hostname)
 
-
     def _reregister(self) -> None:
         """Send the remembered registrations again (the API layer fills this in)."""
 
@@ -134,6 +133,9 @@ class ClientEngine:
         self._queues.stop_all()
         with self._lock:
             self._running = False
+            if self._outbox:
+                log.warning("%s: closed with %d message(s) still unsent; they are discarded",
+                            self._name, len(self._outbox))
             self._outbox.clear()
 
     # ---- outgoing path -----------------------------------------------------------------------------
@@ -319,6 +321,8 @@ class ClientEngine:
                 log.warning("%s: lost the DB at %s:%d: %s", self._name, self._host, self._port, exc)
         except ProtocolError as exc:
             log.error("%s: malformed data from the DB, dropping the connection: %s", self._name, exc)
+        except Exception:
+            log.exception("%s: unexpected error on the I/O thread; reconnecting", self._name)
 
     def _disconnected(self, conn: PacketSocket) -> None:
         with self._lock:
