@@ -145,3 +145,7 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         app.stop()
     return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -197,7 +197,7 @@ class _ModuleAnalyzer(ast.NodeVisitor):
         A return annotation that is a TypeVar takes the type of the first argument (``def f(m: M) -> M``);
         ``tuple[A, B]`` results are indexed when the call is unpacked.
         """
-        callee = self._eval(call.func, node, "callee")
+        callee = self._callee(call.func, node)
         if isinstance(callee, type):
             return self._as_type(callee, call, node)
         try:
@@ -216,6 +216,17 @@ class _ModuleAnalyzer(ast.NodeVisitor):
             f"{self._where(node)}: `{ast.unparse(call.func)}` is not annotated with a specific message return type "
             f"(got {result!r}); annotate it, or use a TypeVar for 'same type as the argument'"
         )
+
+    def _callee(self, func: ast.expr, node: ast.AST) -> object:
+        """The function a call invokes; ``obj.method`` on a local of known class resolves through the class."""
+        if isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name):
+            types = _FunctionTypes(self.func_stack[-1] if self.func_stack else None)
+            origin = types.origins.get(func.value.id)
+            if origin is not None and origin.annotation is not None:
+                owner = self._eval(origin.annotation, node, "receiver type")
+                if isinstance(owner, type) and hasattr(owner, func.attr):
+                    return getattr(owner, func.attr)
+        return self._eval(func, node, "callee")
 
     def _class_for(self, full_name: str, near: type, node: ast.AST) -> type:
         from google.protobuf import symbol_database

@@ -25,6 +25,10 @@ def make_course() -> DesiredCourse:
 
 def course_and_notes() -> tuple[DesiredCourse, list[str]]:
     return DesiredCourse(), []
+
+class Plan:
+    def to_message(self, now: float) -> HelmStateReport:
+        return HelmStateReport()
 """
 
 
@@ -67,6 +71,8 @@ def test_finds_calls_and_resolves_types_every_supported_way(write_module) -> Non
             chosen, _notes = course_and_notes()
             self.interthread().publish(groups.desired_course, chosen)           # tuple element
             self.interprocess().publish(groups.raw_in, "text")                  # CSTR
+            plan: Plan = self.plans.pop(0)
+            self.interprocess().publish(groups.helm_state, plan.to_message(0.0))  # method of an annotated local
     """)
     ns = "goby::middleware::frontseat::"
     pb = "goby::middleware::frontseat::protobuf::"
@@ -79,6 +85,7 @@ def test_finds_calls_and_resolves_types_every_supported_way(write_module) -> Non
         ("interprocess", "publishes", "test::custom;3", "PROTOBUF", pb + "DesiredCourse"),
         ("interthread", "publishes", ns + "desired_course", "CXX_OBJECT", pb + "DesiredCourse"),
         ("interprocess", "publishes", ns + "raw_in", "CSTR", "std::string"),
+        ("interprocess", "publishes", ns + "helm_state", "PROTOBUF", pb + "HelmStateReport"),
     }
     interface = analyze_modules("app", [module])
     thread = f"{module}.Helm"

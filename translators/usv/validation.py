@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TypeVar
 
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
@@ -103,7 +104,10 @@ def _check_in_place(msg: Message, where: str) -> None:
             setattr(msg, field.name, _checked_value(bounds, value, where, field))
 
 
-def check_dccl_bounds(msg: Message) -> Message:
+M = TypeVar("M", bound=Message)
+
+
+def check_dccl_bounds(msg: M) -> M:
     """A copy of ``msg`` as DCCL would deliver it, or :class:`DcclBoundsError` if DCCL could not deliver it.
 
     Required fields must be set; every numeric field with DCCL min/max must lie inside them after rounding to
