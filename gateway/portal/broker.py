@@ -128,6 +128,7 @@ class Broker:
 
         rep = self._mctx.socket(zmq.REP)
         rep.setsockopt(zmq.LINGER, 0)
+        rep.setsockopt(zmq.IPV6, 1)
         try:
             endpoint = manager_endpoint(self.ipc, bind=True)
             if self.is_tcp and self.ipc.tcp_port == 0:

@@ -28,6 +28,7 @@ def request_endpoints(
     request = ManagerRequest(request=PROVIDE_PUB_SUB_SOCKETS, client_name=client_name, client_pid=os.getpid())
     req = zctx.socket(zmq.REQ)
     req.setsockopt(zmq.LINGER, 0)
+    req.setsockopt(zmq.IPV6, 1)
     try:
         try:
             req.connect(endpoint)

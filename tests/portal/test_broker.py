@@ -148,6 +148,18 @@ def test_tcp_transport_end_to_end(tmp_path: Path) -> None:
         assert got[0].a == 1
 
 
+def test_tcp_over_ipv6_loopback(tmp_path: Path) -> None:
+    with broker_process(tmp_path, platform="tcp6", tcp=True) as tcp_broker:
+        cfg = tcp_broker.interprocess_config()
+        cfg.ip_address = "::1"  # preferred over ipv4_address, bracketed in endpoints
+        with PortalClient(cfg, "v6_client") as client:
+            assert client.portal._pub_endpoint.startswith("tcp://[::1]:")
+            got = client.collect("v6", Sample)
+            assert client.wait_subscribed()
+            client.publish("v6", Sample(a=6))
+            assert client.poll_until(lambda: bool(got), 20)
+
+
 def test_in_process_broker_start_stop_is_idempotent(tmp_path: Path) -> None:
     cfg = GobyDaemonConfig()
     cfg.interprocess.platform = "inproc"
