@@ -313,3 +313,34 @@ def test_warped_db_publishes_warped_time() -> None:
             assert got and got[0].double() == pytest.approx(time.time() * 10.0, rel=1e-6)
         finally:
             client.close()
+
+
+class AheadClock(MoosClock):
+    """Test double: a clock running 100 s ahead, standing in for a DB host whose clock is off."""
+
+    def local_time(self, apply_warp: bool = True) -> float:
+        return super().local_time(apply_warp) + 100.0
+
+
+def test_skew_is_learned_from_the_welcome_and_kept_by_timing_replies() -> None:
+    from gateway.moos.server import MoosDB
+
+    db = MoosDB(community="skewed")
+    db.clock = db.db.clock = AheadClock()
+    with db:
+        clock = MoosClock()
+        client = comms(clock=clock)
+        client.set_quiet(True)  # a quiet client corrects its time even when the DB runs on the same host
+        client.set_on_connect_callback(lambda: client.register("SKEWED", 0))
+        client.run("127.0.0.1", db.port, "skewer")
+        try:
+            assert client.wait_until_connected(10_000)
+            assert clock.skew == pytest.approx(100.0, abs=0.5)  # from the WELCOME
+            welcome_skew = clock.skew
+            assert wait_for(lambda: clock.skew != welcome_skew, 5)  # timing replies blend in new measurements
+            assert clock.skew == pytest.approx(100.0, abs=0.5)
+            client.notify("SKEWED", 1.0)
+            (msg,) = collect_mail(client, ["SKEWED"])
+            assert msg.time() == pytest.approx(time.time() + 100.0, abs=1.0)  # stamped in the DB's time
+        finally:
+            client.close()
