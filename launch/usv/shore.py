@@ -121,7 +121,7 @@ class ShoreOperator(SingleThreadApplication):
     def loop(self) -> None:
         """Publish every command whose time has come. Runs on the main thread at 2 Hz (times warp)."""
         while self._t0 is not None and self._plan and self._plan[0].at <= self._sim_elapsed():
-            planned = self._plan.pop(0)
+            planned: ScheduledCommand = self._plan.pop(0)
             try:
                 message = check_dccl_bounds(planned.to_message(clock.now()))
             except DcclBoundsError as error:

@@ -1,0 +1,63 @@
+"""The interface files we ship: derived from the code, identical to what is committed, faithful to Goby."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from gateway.interfaces.analyze import analyze_modules
+from gateway.interfaces.catalog import SHIPPED_APPLICATIONS
+from gateway.interfaces.cli import generate_text, interface_file_name
+from gateway.interfaces.deployment import DEFAULT_INTERFACES_DIR, load_deployment
+from gateway.interfaces.visualize import VizOptions, build_graph
+
+FS = "goby::middleware::frontseat::"
+PB = "goby::middleware::frontseat::protobuf::"
+
+# goby_frontseat_interface's interprocess interface (goby_frontseat.md §4.3): (direction, group, type), all PROTOBUF.
+ORIGINAL_FRONTSEAT_INTERFACE = {
+    ("subscribes", FS + "helm_state", PB + "HelmStateReport"),
+    ("subscribes", FS + "command_request", PB + "CommandRequest"),
+    ("subscribes", FS + "desired_course", PB + "DesiredCourse"),
+    ("subscribes", FS + "data_to_frontseat", PB + "InterfaceData"),
+    ("subscribes", FS + "raw_send_request", PB + "Raw"),
+    ("subscribes", "goby::datum_update", "goby::middleware::protobuf::DatumUpdate"),
+    ("publishes", FS + "command_response", PB + "CommandResponse"),
+    ("publishes", FS + "data_from_frontseat", PB + "InterfaceData"),
+    ("publishes", FS + "node_status", PB + "NodeStatus"),
+    ("publishes", FS + "raw_in", PB + "Raw"),
+    ("publishes", FS + "raw_out", PB + "Raw"),
+    ("publishes", FS + "status", PB + "InterfaceStatus"),
+}
+
+
+def test_frontseat_interface_matches_the_original() -> None:
+    interface = analyze_modules("frontseat-interface", SHIPPED_APPLICATIONS["frontseat-interface"])
+    interprocess = [e for e in interface.entries if e.layer == "interprocess"]
+    assert {e.scheme for e in interprocess} == {"PROTOBUF"}
+    assert {(e.direction, e.group, e.type) for e in interprocess} == ORIGINAL_FRONTSEAT_INTERFACE
+
+
+@pytest.mark.parametrize("app", sorted(SHIPPED_APPLICATIONS))
+def test_committed_interface_file_is_up_to_date(app: str) -> None:
+    committed = DEFAULT_INTERFACES_DIR / interface_file_name(app)
+    assert committed.exists(), f"missing {committed}: run `make interfaces`"
+    assert generate_text(app) == committed.read_text(), f"{committed.name} is stale: run `make interfaces`"
+
+
+def _edge_set(path: Path) -> set[tuple[str, str, str]]:
+    graph = build_graph(load_deployment(path), VizOptions(no_disconnected=True))
+    return {(e.publisher.application, e.subscriber.application, e.group) for e in graph.edges
+            if e.layer == "interprocess"}
+
+
+def test_usv_deployment_has_the_edges_the_mission_needs() -> None:
+    edges = _edge_set(DEFAULT_INTERFACES_DIR / "usv_deployment.yml")
+    # the embedded FrontSeatTranslation and the interface talk over interprocess inside one process
+    assert ("frontseat-interface", "frontseat-interface", FS + "desired_course") in edges
+    assert ("frontseat-interface", "frontseat-interface", FS + "helm_state") in edges
+    assert ("frontseat-interface", "frontseat-interface", FS + "node_status") in edges
+    assert ("usv-manager", "moos-gateway", "goby3_course::usv_command;0") in edges
+    assert ("usv-command", "usv-manager", "goby3_course::shore::usv_command;0") in edges
+    assert ("moos-gateway", "usv-command", "goby3_course::usv_command_ack") in edges
