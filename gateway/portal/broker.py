@@ -68,6 +68,7 @@ class Broker:
         self._manager_stop: zmq.Socket | None = None
         self._started = False
         self._stopped = False
+        self._ipc_files: list[str] = []  # created by this broker, removed on stop
         self._ready = threading.Event()
         self._errors: list[BaseException] = []
 
@@ -111,7 +112,9 @@ class Broker:
             else:
                 base = ipc_base(self.ipc)
                 xpub.bind(f"ipc://{base}.xpub")
+                self._ipc_files.append(f"{base}.xpub")
                 xsub.bind(f"ipc://{base}.xsub")
+                self._ipc_files.append(f"{base}.xsub")
         except zmq.ZMQError as exc:
             xpub.close()
             xsub.close()
@@ -136,6 +139,8 @@ class Broker:
             else:
                 rep.bind(endpoint)
                 self.manager_port = self.ipc.tcp_port if self.is_tcp else 0
+                if not self.is_tcp:
+                    self._ipc_files.append(f"{ipc_base(self.ipc)}.manager")
         except zmq.ZMQError as exc:
             rep.close()
             self.stop()
@@ -169,6 +174,11 @@ class Broker:
         for zctx in (self._zctx, self._mctx):
             if zctx is not None:
                 zctx.term()
+        for path in self._ipc_files:
+            try:
+                os.unlink(path)
+            except OSError:
+                pass
         log.info("broker stopped")
 
     def __enter__(self) -> Broker:

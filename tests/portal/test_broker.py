@@ -167,9 +167,11 @@ def test_in_process_broker_start_stop_is_idempotent(tmp_path: Path) -> None:
     cfg.router_threads = 1
     with Broker(cfg) as broker:
         assert broker.endpoints()["manager"] == f"ipc://{tmp_path}/b.manager"
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["b.manager", "b.xpub", "b.xsub"]
         with zmq.Context() as zctx:
             request_endpoints(zctx, cfg.interprocess, "c", timeout_s=10)
     broker.stop()
+    assert list(tmp_path.iterdir()) == []  # the socket files are removed on a clean stop
     assert BrokerProcess(tmp_path, "x").stop() is None
 
 
