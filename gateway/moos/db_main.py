@@ -23,8 +23,22 @@ log = logging.getLogger(__name__)
 
 _IGNORED_FLAGS = ("-s", "--single_threaded", "-b", "--moos_boost", "-d", "--dns", "--tcpnodelay",
                   "--print_heart_beat", "--moos_suicide_disable", "--moos_suicide_print", "--moos_no_colour")
-_IGNORED_VALUES = ("--warning_latency", "--response", "--audit_port", "--event_log", "--webserver_port",
+_IGNORED_VALUES = ("--warning_latency", "--audit_port", "--event_log", "--webserver_port",
                    "--moos_suicide_channel", "--moos_suicide_port", "--moos_suicide_phrase")
+
+
+def parse_response(text: str) -> dict[str, float]:
+    """``x_app:20,*_instrument:0`` -> {name or pattern: seconds}; raises ValueError naming the bad entry."""
+    result: dict[str, float] = {}
+    for entry in filter(None, (part.strip() for part in text.split(","))):
+        name, sep, ms = entry.rpartition(":")
+        try:
+            if not sep or not name:
+                raise ValueError
+            result[name] = float(ms) / 1000.0
+        except ValueError:
+            raise ValueError(f"--response entry {entry!r} is not name:milliseconds") from None
+    return result
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -40,6 +54,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="address to bind (default 127.0.0.1; 0.0.0.0 for every interface like the C++ DB)")
     parser.add_argument("--max_packet_bytes", type=int, default=64 * 1024 * 1024,
                         help="largest packet accepted from a client before it is dropped")
+    parser.add_argument("--response", default="",
+                        help="name:ms or pattern:ms, comma separated: ask those async clients to write no more "
+                        "often than that (sent in the timing reply, as MOOSDB does)")
     parser.add_argument("--moos_print_version", action="store_true", help="print the version and exit")
     for flag in _IGNORED_FLAGS:
         parser.add_argument(flag, action="store_true", dest="ignored_" + flag.strip("-"), help=argparse.SUPPRESS)
@@ -83,8 +100,9 @@ def main(argv: list[str] | None = None) -> int:
         timeout = args.moos_timeout
 
     try:
+        response = parse_response(args.response)
         server = MoosDB(args.moos_address, port, community, time_warp=warp, client_timeout=timeout,
-                        max_packet_bytes=args.max_packet_bytes)
+                        max_packet_bytes=args.max_packet_bytes, response=response)
         server.start()
     except (OSError, ValueError) as exc:
         log.error("cannot start the MOOSDB on %s:%d: %s", args.moos_address, port, exc)

@@ -41,6 +41,7 @@ from .message import (
     to_bytes,
     to_str,
 )
+from .wildcard import wild_match
 
 log = logging.getLogger(__name__)
 
@@ -90,6 +91,7 @@ class MoosDB:
         stall_timeout: float = 6.0,
         handshake_timeout: float = HANDSHAKE_TIMEOUT_S,
         high_water: int = HIGH_WATER,
+        response: dict[str, float] | None = None,
     ) -> None:
         self.host = host
         self._requested_port = int(port)
@@ -100,6 +102,8 @@ class MoosDB:
         self.handshake_timeout = float(handshake_timeout)
         self.high_water = int(high_water)
         self.low_water = min(LOW_WATER, self.high_water // 4)
+        # MOOSDB's --response: client name or wildcard pattern -> seconds asked between the client's writes
+        self.response = {to_bytes(k): float(v) for k, v in (response or {}).items()}
         self.max_packet_bytes = max_packet_bytes
         self.db = MoosDatabase(community, self.clock)
         self._hostname = to_bytes(socket.gethostname())
@@ -343,7 +347,7 @@ class MoosDB:
             now_local = self.clock.local_time()
             db.record_timing(client.name, (now_local - timing.msg_time) * 1000.0 / self.clock.warp)
             timing.dval = now_local
-            timing.dval2 = 0.0
+            timing.dval2 = self._response_delay(client.name)
         replies, _ = db.process(packet)
         out: list[bytes] = []
         if not client.asynchronous:
@@ -355,6 +359,17 @@ class MoosDB:
             out.extend(encode_message(m) for m in replies)
         if out:
             self._send(client, frame_packet(out))
+
+    def _response_delay(self, name: bytes) -> float:
+        """The write period this client was asked to keep (``--response``), told to it in ``T.val2``."""
+        if not self.response:
+            return 0.0
+        if name in self.response:
+            return self.response[name]
+        for pattern, delay in self.response.items():
+            if wild_match(pattern, name):
+                return delay
+        return 0.0
 
     def _push_waiting_mail(self) -> None:
         """Asynchronous clients get their held mail pushed without asking (sync clients wait for their poll)."""

@@ -344,3 +344,39 @@ def test_skew_is_learned_from_the_welcome_and_kept_by_timing_replies() -> None:
             assert msg.time() == pytest.approx(time.time() + 100.0, abs=1.0)  # stamped in the DB's time
         finally:
             client.close()
+
+
+def test_response_option_slows_a_client_down() -> None:
+    """MOOSDB's --response: the DB asks a client (by name or pattern) to batch its writes; nothing is lost."""
+    from gateway.moos.db_main import parse_response
+    from gateway.moos.testing import running_moosdb
+
+    assert parse_response("x_app:20, *_inst:0") == {"x_app": 0.02, "*_inst": 0.0}
+    with pytest.raises(ValueError, match="not name:milliseconds"):
+        parse_response("oops")
+
+    def arrival_spread(db_port: int, name: str) -> float:
+        with connected_comms(db_port, "watch_" + name, [name + "_V"]) as watcher, \
+                connected_comms(db_port, name) as writer:
+            wait_for(lambda: False, 1.3)  # a timing round trip tells the writer its delay
+
+            def write_spaced() -> None:
+                for i in range(5):
+                    writer.notify(name + "_V", float(i))
+                    time.sleep(0.05)
+
+            sender = threading.Thread(target=write_spaced, name="spaced-writer")
+            sender.start()
+            arrivals: dict[float, float] = {}
+            deadline = time.monotonic() + 10
+            while len(arrivals) < 5 and time.monotonic() < deadline:
+                for m in watcher.fetch():
+                    arrivals[m.double()] = time.monotonic()
+                time.sleep(0.002)
+            sender.join(10)
+            assert sorted(arrivals) == [0.0, 1.0, 2.0, 3.0, 4.0]
+            return arrivals[3.0] - arrivals[1.0]
+
+    with running_moosdb(response={"slow*": 0.3}) as db:
+        assert arrival_spread(db.port, "slowpoke") < 0.05  # 1..3 waited for the same batch
+        assert arrival_spread(db.port, "quick") >= 0.08  # sent as they came, 50 ms apart
