@@ -225,7 +225,8 @@ class PacketReader:
 
     def _decode_region(self, end: int) -> list[list[MoosMessage]]:
         """Decode the whole packets in ``_buf[:end]`` and drop them from the buffer."""
-        region = bytes(self._buf[:end])
+        with memoryview(self._buf) as view:
+            region = bytes(view[:end])  # one copy (slicing the bytearray first would make two)
         del self._buf[:end]
         packets = []
         pos = 0

@@ -118,6 +118,8 @@ class MoosDB:
         self._paused = False
         self._congested: set[_Client] = set()
         self._lock = threading.Lock()
+        self._recv_buf = bytearray(RECV_BYTES)
+        self._recv_view = memoryview(self._recv_buf)
         self.port = 0
         self.dropped: list[tuple[str, str]] = []  # (client, reason) for every client dropped for a fault
 
@@ -259,19 +261,20 @@ class MoosDB:
     # ---- reading -----------------------------------------------------------------------------------
     def _read(self, client: _Client) -> None:
         try:
-            data = client.sock.recv(RECV_BYTES)
+            n = client.sock.recv_into(self._recv_buf)
         except (BlockingIOError, InterruptedError):
             return
         except OSError as exc:
             self._close(client, f"read failed: {exc}", fault=False)
             return
-        if not data:
+        if not n:
             self._close(client, "closed the connection", fault=False)
             return
+        data = self._recv_view[:n]  # one reused buffer: a fresh 256 KiB bytes per recv would cost an mmap
         client.last_rx = _time.monotonic()
         if client.state == _PROTOCOL:
             need = PROTOCOL_STRING_SIZE - len(client.proto_buf)
-            client.proto_buf += data[:need]
+            client.proto_buf += bytes(data[:need])
             data = data[need:]
             if len(client.proto_buf) < PROTOCOL_STRING_SIZE:
                 return
