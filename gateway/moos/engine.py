@@ -27,7 +27,7 @@ from .connection import PacketSocket, Welcome, client_handshake, open_socket
 from .errors import ConnectionClosedError, HandshakeError, MoosError, PoisonedError, ProtocolError
 from .message import DOUBLE, NOTIFY, NULL_MSG, TIMING, TIMING_KEY, MoosMessage, to_bytes
 
-log = logging.getLogger("gateway.moos.client")
+log = logging.getLogger(__name__)
 
 TIMING_PERIOD_S = 1.0
 WRITER_IDLE_WAKE_S = 0.333
