@@ -120,3 +120,32 @@ def test_uxms_scopes_our_db(db_port: int, tmp_path: Path) -> None:
                     proc.wait(5)
         text = out.read_bytes().decode(errors="replace")
         assert "visible-value" in text and "poster" in text
+
+
+def test_a_real_moos_app_runs_against_our_db(tmp_path: Path) -> None:
+    """uTimerScript (a C++ CMOOSApp: async comms, mission file, app tick) publishes through our DB."""
+    script = _tool_or_skip("uTimerScript")
+    from gateway.moos.testing import running_moosdb
+
+    with running_moosdb(community="tsx") as db, connected_comms(db.port, "watch_ts", ["TS_HELLO", "TS_NUM"]) as w:
+        mission = tmp_path / "ts.moos"
+        mission.write_text(
+            f"ServerHost = localhost\nServerPort = {db.port}\nCommunity = tsx\n\n"
+            "ProcessConfig = uTimerScript\n{\n  AppTick = 4\n  CommsTick = 4\n"
+            '  event = var=TS_HELLO, val="world", time=0.2\n  event = var=TS_NUM, val=42, time=0.4\n}\n'
+        )
+        # argv[0] must be the bare name: a MOOSApp looks up "ProcessConfig = <argv[0]>"
+        proc = subprocess.Popen(["uTimerScript", str(mission)], executable=script, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL, cwd=tmp_path)
+        try:
+            got = {m.key(): m for m in collect_mail(w, ["TS_HELLO", "TS_NUM"], timeout=20)}
+        finally:
+            proc.terminate()
+            try:
+                proc.wait(5)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(5)
+        assert got["TS_HELLO"].string() == "world" and got["TS_HELLO"].source() == "uTimerScript"
+        assert got["TS_NUM"].is_double() and got["TS_NUM"].double() == 42.0
+        assert got["TS_NUM"].community() == "tsx"
