@@ -62,10 +62,16 @@ class InterfaceRegistry:
         Path(path).write_text(self.to_json())
 
     def write_if_requested(self) -> None:
-        """Write to ``$GOBY_INTERFACE_REGISTRY`` if set (an error is logged, never raised)."""
+        """Write to ``$GOBY_INTERFACE_REGISTRY`` if set (an error is logged, never raised).
+
+        If it names a directory, each process writes ``<dir>/<pid>.json``, so one setting can serve a whole
+        launch of many applications.
+        """
         target = os.environ.get(ENV_VAR)
         if not target:
             return
+        if os.path.isdir(target):
+            target = os.path.join(target, f"{os.getpid()}.json")
         try:
             self.write(target)
         except OSError as exc:

@@ -12,6 +12,11 @@ from pathlib import Path
 
 import pytest
 
+from gateway.interfaces.deployment import DEFAULT_INTERFACES_DIR
+from gateway.interfaces.drift import covered_threads, drift_problems
+from gateway.interfaces.interface_yaml import load as load_interface
+from gateway.portal.interface_registry import ENV_VAR as REGISTRY_ENV
+from gateway.portal.interface_registry import read_entries
 from launch.config import free_tcp_port
 from launch.usv.analysis import (
     bhv_waypoints,
@@ -69,7 +74,10 @@ def run_mission(run_dir: Path, moosdb: str, helm: str) -> MissionResult:
         ),
     ],
 )
-def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm):
+def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm, monkeypatch):
+    registry_dir = tmp_path / "interface_registry"
+    registry_dir.mkdir()
+    monkeypatch.setenv(REGISTRY_ENV, str(registry_dir))  # every app records the calls it made (see below)
     result = run_mission(tmp_path / "run", moosdb, helm)
     record = result.record
     waypoints = bhv_waypoints(UsvSettings().bhv_file)
@@ -116,3 +124,10 @@ def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm):
     assert len(result.outcomes) == 8, report
     assert all(o.clean for o in result.outcomes), report
     assert result.log_errors == [], report
+
+    # What the apps really published and subscribed is what their interface files say (no drift).
+    runtime = [entry for path in registry_dir.glob("*.json") for entry in read_entries(path)]
+    interfaces = [load_interface(path) for path in sorted(DEFAULT_INTERFACES_DIR.glob("*_interface.yml"))]
+    covered = covered_threads(runtime, interfaces)
+    assert {"FrontSeatInterface", "FrontSeatTranslation", "CommandTranslation", "USVManager", "ShoreOperator"} <= covered
+    assert drift_problems(runtime, interfaces) == []
