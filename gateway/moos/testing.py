@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -26,6 +27,37 @@ def free_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
+
+
+def port_open(port: int, host: str = "127.0.0.1") -> bool:
+    """True when something accepts TCP connections on ``host:port`` (a server has finished starting)."""
+    with socket.socket() as s:
+        s.settimeout(0.2)
+        return s.connect_ex((host, port)) == 0
+
+
+def private_netns() -> bool:
+    """True when this process sees no network interface but loopback (a private network namespace)."""
+    try:
+        lines = Path("/proc/self/net/dev").read_text().splitlines()[2:]
+    except OSError:
+        return False
+    return {line.split(":", 1)[0].strip() for line in lines} == {"lo"}
+
+
+def real_moos_skip_reason(*binaries: str) -> str | None:
+    """Why tests cannot use the real MOOS-IvP ``binaries`` here, or None when they can.
+
+    The C++ MOOSDB listens on every address, so the real programs are used only on PATH *and* inside a private
+    network namespace (e.g. ``/opt/moos/bin/netns-run``); a developer's machine with MOOS-IvP installed does not
+    expose test servers to its network by accident.
+    """
+    for binary in binaries or ("MOOSDB",):
+        if shutil.which(binary) is None:
+            return f"the real {binary} is not on PATH"
+    if not private_netns():
+        return "the real MOOSDB listens on all addresses; run inside a private network namespace (netns-run)"
+    return None
 
 
 def wait_for(predicate: Callable[[], Any], timeout: float = 10.0, interval: float = 0.01) -> Any:

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import contextlib
 import math
-import shutil
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
@@ -20,23 +19,15 @@ from pathlib import Path
 import pytest
 
 from gateway.moos import MoosClock
-from gateway.moos.testing import free_port
+from gateway.moos.testing import free_port, real_moos_skip_reason
 
 from .moos_harness import REPO, WARP, helm_process, observer, ring_stats, vehicle, write_mission
 from .test_closed_loop import SURVEY, WATCH
 
-
-def _private_netns() -> bool:
-    names = [line.split(":")[0].strip() for line in Path("/proc/self/net/dev").read_text().splitlines()[2:]]
-    return names == ["lo"]
-
-
 pytestmark = [
     pytest.mark.interop,
-    pytest.mark.skipif(shutil.which("pHelmIvP") is None or shutil.which("MOOSDB") is None,
-                       reason="the real pHelmIvP and MOOSDB are not on PATH"),
-    pytest.mark.skipif(not _private_netns(),
-                       reason="the real MOOSDB listens on all addresses: run inside /opt/moos/bin/netns-run"),
+    pytest.mark.skipif(real_moos_skip_reason("MOOSDB", "pHelmIvP") is not None,
+                       reason=str(real_moos_skip_reason("MOOSDB", "pHelmIvP"))),
 ]
 
 HELMS = {"pHelmIvP": lambda mission: ["pHelmIvP", str(mission)], "ivp-helm": None}

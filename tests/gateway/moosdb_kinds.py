@@ -7,36 +7,16 @@ The real MOOSDB listens on every address, so it is used only inside a private ne
 from __future__ import annotations
 
 import contextlib
-import shutil
-import socket
 import subprocess
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
-from gateway.moos.testing import free_port, moosdb_process
-
-
-def _only_loopback() -> bool:
-    try:
-        lines = Path("/proc/self/net/dev").read_text().splitlines()[2:]
-    except OSError:
-        return False
-    return {line.split(":", 1)[0].strip() for line in lines} == {"lo"}
+from gateway.moos.testing import free_port, moosdb_process, port_open, real_moos_skip_reason
 
 
 def real_moosdb_skip_reason() -> str | None:
-    if shutil.which("MOOSDB") is None:
-        return "the real MOOSDB is not on PATH"
-    if not _only_loopback():
-        return "the real MOOSDB listens on all addresses; run inside a private network namespace (netns-run)"
-    return None
-
-
-def _listening(port: int) -> bool:
-    with socket.socket() as s:
-        s.settimeout(0.2)
-        return s.connect_ex(("127.0.0.1", port)) == 0
+    return real_moos_skip_reason("MOOSDB")
 
 
 class RealMoosDB:
@@ -52,7 +32,7 @@ class RealMoosDB:
             self.proc = subprocess.Popen(["MOOSDB", f"--moos_port={self.port}", "--moos_suicide_disable"],
                                          stdout=out, stderr=subprocess.STDOUT, cwd=self.workdir)
         deadline = time.monotonic() + timeout
-        while not _listening(self.port):
+        while not port_open(self.port):
             if self.proc.poll() is not None or time.monotonic() > deadline:
                 self.stop()
                 raise RuntimeError(f"MOOSDB did not start: {(self.workdir / 'MOOSDB.out').read_text()}")

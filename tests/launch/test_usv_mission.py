@@ -15,6 +15,7 @@ import pytest
 from gateway.interfaces.deployment import DEFAULT_INTERFACES_DIR
 from gateway.interfaces.drift import covered_threads, drift_problems
 from gateway.interfaces.interface_yaml import load as load_interface
+from gateway.moos.testing import real_moos_skip_reason
 from gateway.portal.interface_registry import ENV_VAR as REGISTRY_ENV
 from gateway.portal.interface_registry import read_entries
 from launch.config import free_tcp_port
@@ -34,7 +35,7 @@ WARP = 30
 DURATION_S = 1150.0
 SCHEDULE = "0:polygon:6:200,450:waypoints,700:polygon:8:400"
 
-REAL_MOOS = shutil.which("MOOSDB") is not None and shutil.which("pHelmIvP") is not None
+REAL_MOOS_SKIP = real_moos_skip_reason("MOOSDB", "pHelmIvP")
 
 
 def run_mission(run_dir: Path, moosdb: str, helm: str) -> MissionResult:
@@ -70,7 +71,7 @@ def run_mission(run_dir: Path, moosdb: str, helm: str) -> MissionResult:
         pytest.param(
             "MOOSDB", "pHelmIvP", id="real-moos-ivp",
             marks=[pytest.mark.interop,
-                   pytest.mark.skipif(not REAL_MOOS, reason="MOOSDB and pHelmIvP are not on PATH")],
+                   pytest.mark.skipif(REAL_MOOS_SKIP is not None, reason=str(REAL_MOOS_SKIP))],
         ),
     ],
 )

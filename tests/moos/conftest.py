@@ -7,7 +7,6 @@ whose only interface is loopback), e.g. under ``/opt/moos/bin/netns-run``.
 from __future__ import annotations
 
 import contextlib
-import shutil
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
@@ -15,33 +14,11 @@ from pathlib import Path
 import pytest
 
 from gateway.moos.server import MoosDB
-from gateway.moos.testing import free_port, wait_for
-
-
-def private_netns() -> bool:
-    """True when this process sees no network interface but loopback."""
-    try:
-        lines = Path("/proc/self/net/dev").read_text().splitlines()[2:]
-    except OSError:
-        return False
-    names = {line.split(":", 1)[0].strip() for line in lines}
-    return names == {"lo"}
+from gateway.moos.testing import free_port, port_open, real_moos_skip_reason, wait_for
 
 
 def real_moosdb_skip_reason() -> str | None:
-    if shutil.which("MOOSDB") is None:
-        return "the real MOOSDB is not on PATH"
-    if not private_netns():
-        return "the real MOOSDB listens on all addresses; run inside a private network namespace (netns-run)"
-    return None
-
-
-def _port_open(port: int) -> bool:
-    import socket
-
-    with socket.socket() as s:
-        s.settimeout(0.2)
-        return s.connect_ex(("127.0.0.1", port)) == 0
+    return real_moos_skip_reason("MOOSDB")
 
 
 @contextlib.contextmanager
@@ -55,7 +32,7 @@ def real_moosdb(tmp_path: Path, community: str = "moos", warp: float = 1.0) -> I
         stdout=log, stderr=subprocess.STDOUT, cwd=tmp_path,
     )
     try:
-        if not wait_for(lambda: _port_open(port) or proc.poll() is not None, 10) or proc.poll() is not None:
+        if not wait_for(lambda: port_open(port) or proc.poll() is not None, 10) or proc.poll() is not None:
             raise RuntimeError(f"MOOSDB did not start: {(tmp_path / f'MOOSDB-{port}.log').read_text()}")
         yield port
     finally:

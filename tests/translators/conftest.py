@@ -19,12 +19,11 @@ from translator_procs import (
     gateway_args,
     moosdb,
     plugin_env,
-    real_moos_skip_reason,
     running,
     wait_until,
 )
 
-from gateway.moos.testing import connected_comms
+from gateway.moos.testing import connected_comms, real_moos_skip_reason
 from gateway.portal.testing import BrokerProcess, PortalClient, broker_process
 from translators.usv import groups as usv_groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck

@@ -9,41 +9,16 @@ from __future__ import annotations
 
 import contextlib
 import os
-import shutil
 import signal
-import socket
 import subprocess
 import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
-from gateway.moos.testing import free_port, moosdb_process, wait_for
+from gateway.moos.testing import free_port, moosdb_process, port_open, wait_for
 
 ORIGIN = (43.8253, -70.3304)  # s1_alpha (ivp_helm.md §7.3)
-
-
-def private_netns() -> bool:
-    """True when this process sees no network interface but loopback."""
-    try:
-        lines = Path("/proc/self/net/dev").read_text().splitlines()[2:]
-    except OSError:
-        return False
-    return {line.split(":", 1)[0].strip() for line in lines} == {"lo"}
-
-
-def real_moos_skip_reason(binary: str = "MOOSDB") -> str | None:
-    if shutil.which(binary) is None:
-        return f"the real {binary} is not on PATH"
-    if not private_netns():
-        return f"the real {binary} listens on all addresses; run inside a private network namespace (netns-run)"
-    return None
-
-
-def _port_open(port: int) -> bool:
-    with socket.socket() as s:
-        s.settimeout(0.2)
-        return s.connect_ex(("127.0.0.1", port)) == 0
 
 
 class ChildProcess:
@@ -84,7 +59,7 @@ def moosdb(kind: str, workdir: Path, community: str = "usv") -> Iterator[int]:
     child = ChildProcess("MOOSDB", ["MOOSDB", f"--moos_port={port}", f"--moos_community={community}",
                                     "--moos_suicide_disable"], workdir)
     try:
-        if not wait_for(lambda: _port_open(port) or not child.alive(), 20) or not child.alive():
+        if not wait_for(lambda: port_open(port) or not child.alive(), 20) or not child.alive():
             raise RuntimeError(f"MOOSDB did not start: {child.output()}")
         yield port
     finally:
