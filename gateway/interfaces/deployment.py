@@ -41,9 +41,12 @@ class Deployment:
     platforms: dict[str, Platform] = field(default_factory=dict)
 
 
+def _interfaces_dir() -> str:
+    return os.environ.get("GOBY_INTERFACES_DIR", str(DEFAULT_INTERFACES_DIR))
+
+
 def _resolve(entry: str, base: Path) -> Path:
-    interfaces_dir = os.environ.get("GOBY_INTERFACES_DIR", str(DEFAULT_INTERFACES_DIR))
-    path = Path(entry.replace(INTERFACES_DIR_TOKEN, interfaces_dir))
+    path = Path(entry.replace(INTERFACES_DIR_TOKEN, _interfaces_dir()))
     return path if path.is_absolute() else base / path
 
 
@@ -82,7 +85,9 @@ def load_deployment(path: str | Path) -> Deployment:
     """Read a deployment file and the interface files it names (relative to the deployment file)."""
     path = Path(path)
     try:
-        data = yaml.safe_load(path.read_text())
+        # Substitute before parsing, as Goby's CMake configure step does: an unquoted `- @GOBY_INTERFACES_DIR@/x`
+        # is not valid YAML (`@` cannot start a token), yet the course's deployment files are written that way.
+        data = yaml.safe_load(path.read_text().replace(INTERFACES_DIR_TOKEN, _interfaces_dir()))
     except (OSError, yaml.YAMLError) as exc:
         raise DeploymentError(f"{path}: cannot read deployment: {exc}") from exc
     if not isinstance(data, dict) or "deployment" not in data:

@@ -113,3 +113,15 @@ def test_unreadable_interface_file_is_reported_and_skipped(tmp_path: Path, caplo
     deployment = load_deployment(tmp_path / "d.yml")
     assert deployment.platforms["p"].modules["nomodule"].applications == {}
     assert "Failed to parse broken.yml" in caplog.text and "Failed to parse missing.yml" in caplog.text
+
+
+def test_unquoted_interfaces_dir_token_as_in_the_course(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    iface_dir = tmp_path / "share"
+    iface_dir.mkdir()
+    _write(iface_dir / "a_interface.yml", "a", [
+        PubSubEntry("interprocess", "A", FS + "status", "PROTOBUF", PB + "InterfaceStatus", "publishes")])
+    (tmp_path / "d.yml").write_text(
+        "deployment: d\nplatforms:\n  - name: p\n    interfaces:\n      - @GOBY_INTERFACES_DIR@/a_interface.yml\n")
+    monkeypatch.setenv("GOBY_INTERFACES_DIR", str(iface_dir))
+    deployment = load_deployment(tmp_path / "d.yml")
+    assert list(deployment.platforms["p"].modules["nomodule"].applications) == ["a"]
