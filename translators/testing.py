@@ -66,6 +66,9 @@ def hosted_translators(cfg: GobyMOOSGatewayConfig, *translator_classes: type[Sim
             app.quit()
             if runner is not None:
                 runner.join(30)
+                if runner.is_alive():
+                    # Closing transports under a thread still polling them would hide the real fault.
+                    raise RuntimeError("the hosted gateway's main thread did not stop within 30 s")
             app.close()
         context.close()
 

@@ -187,7 +187,7 @@ class _ModuleAnalyzer(ast.NodeVisitor):
             if isinstance(owner, type) and issubclass(owner, Message):
                 field = owner.DESCRIPTOR.fields_by_name.get(expr.attr)
                 if field is not None and field.message_type is not None:
-                    return self._class_for(field.message_type.full_name, owner, node)
+                    return self._class_for(field.message_type.full_name, node)
             raise AnalysisError(f"{self._where(node)}: `{ast.unparse(expr)}` is not a message field")
         raise AnalysisError(f"{self._where(node)}: cannot tell the type of published `{ast.unparse(expr)}`")
 
@@ -228,7 +228,7 @@ class _ModuleAnalyzer(ast.NodeVisitor):
                     return getattr(owner, func.attr)
         return self._eval(func, node, "callee")
 
-    def _class_for(self, full_name: str, near: type, node: ast.AST) -> type:
+    def _class_for(self, full_name: str, node: ast.AST) -> type:
         from google.protobuf import symbol_database
 
         try:

@@ -99,20 +99,28 @@ class MultiThreadApplication(_Application):
         return instance
 
     def join_thread(self, which: type[SimpleThread] | SimpleThread, timeout: float | None = None) -> int:
-        """Stop and join the launched threads of a class (or one instance); returns how many were joined."""
+        """Stop and join the launched threads of a class (or one instance); returns how many have ended.
+
+        A thread that does not end within ``timeout`` is logged and stays listed, so ``close()`` joins it again.
+        """
         with self._threads_lock:
             chosen = [
                 (inst, t) for inst, t in self._threads
                 if inst is which or (isinstance(which, type) and type(inst) is which)
             ]
-            self._threads = [pair for pair in self._threads if pair not in chosen]
         for inst, _ in chosen:
             inst.quit()
+        joined = []
         for inst, pythread in chosen:
             pythread.join(timeout)
             if pythread.is_alive():
+                # Keep it listed, so close() tries again rather than forgetting a live thread.
                 log.error("thread %s did not stop within %s s", type(inst).__qualname__, timeout)
-        return len(chosen)
+            else:
+                joined.append((inst, pythread))
+        with self._threads_lock:
+            self._threads = [pair for pair in self._threads if pair not in joined]
+        return len(joined)
 
     def threads(self) -> list[SimpleThread]:
         """The launched threads still running (not yet joined)."""

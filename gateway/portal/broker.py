@@ -153,7 +153,9 @@ class Broker:
         manager = threading.Thread(target=self._run_manager, args=(rep, stop_peer), name="broker-manager")
         manager.start()
         self._threads.append(manager)
-        self._ready.wait(10)
+        if not self._ready.wait(10):
+            self.stop()
+            raise BrokerError("the broker's manager thread did not become ready within 10 s")
         log.info("broker ready for platform %r: %s", self.ipc.platform, self.endpoints())
         return self
 

@@ -101,9 +101,6 @@ class ProcessContext:
         for mailbox in list(self._mailboxes):
             mailbox.wake()
 
-    def wait_hold_released(self, timeout: float | None = None) -> bool:
-        return self._hold_released.wait(timeout)
-
     def close(self) -> None:
         """Close transports left open, then terminate the ZeroMQ context; idempotent.
 

@@ -79,9 +79,6 @@ class InterThread:
             if group is None:
                 self._regex = [r for r in self._regex if r.mailbox is not mailbox]
 
-    def has_subscribers(self, group: str, key: str) -> bool:
-        return (group, key) in self._subs or bool(self._regex)
-
     def deliver(self, group: str, key: str, msg: Any, publisher: Mailbox | None, echo: bool = False) -> int:
         """Queue ``msg`` to every subscriber of (group, key); returns how many threads it was queued to."""
         targets = self._subs.get((group, key))

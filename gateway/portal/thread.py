@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import logging
 import math
-import threading
 import time
 from collections.abc import Callable
 from typing import Any
@@ -59,7 +58,6 @@ class SimpleThread:
         self._alive = True
         self._closed = False
         self._next_loop: float | None = None
-        self._owner = threading.get_ident()
 
     # ------------------------------------------------------------------------------------ accessors
     def cfg(self) -> Any:

@@ -300,3 +300,17 @@ def test_publications_of_a_launched_thread_wait_for_the_hold(tmp_path: Path) -> 
             assert app.publisher.held_at_publish is True
             assert rx.poll_until(lambda: len(got) == 3, 30)
     assert [m.a for m in got] == [1, 2, 3]
+
+
+def test_a_thread_that_outlives_the_join_timeout_stays_listed_for_a_later_join() -> None:
+    release = threading.Event()
+    with running_app(InterthreadOnly, no_interprocess_cfg()) as app:
+        worker = app.launch_thread(Worker, SampleAppConfig())
+        started = threading.Event()
+        worker.call_soon(lambda: (started.set(), release.wait(30)))  # busy: cannot see quit() yet
+        assert started.wait(10)
+        assert app.join_thread(Worker, timeout=0.2) == 0
+        assert app.threads() == [worker]  # not forgotten
+        release.set()
+        assert app.join_thread(Worker, timeout=10) == 1
+        assert app.threads() == []
