@@ -22,6 +22,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from bench.stats import percentile
 from gateway.moos.client import comms
 from gateway.moos.testing import moosdb_process
 from gateway.portal.testing import PortalClient, broker_process
@@ -75,11 +76,6 @@ class MoosReceiver:
 
     def close(self) -> None:
         self.client.close(True)
-
-
-def _percentile(values: list[float], q: float) -> float:
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, int(round(q * (len(ordered) - 1))))]
 
 
 def _sample(n: int, send: Callable[[str], None], receive: Callable[[float], list[str]],
@@ -152,8 +148,8 @@ def run(samples: int, burst: int, tick_samples: int) -> list[tuple[str, str, str
                                       _moos_strings(receiver, "BENCH_DIRECT"))
                 goby_direct = _sample(samples, lambda t: peer.publish("bench_direct", t), _goby_strings(peer, goby_box))
                 base_moos, base_goby = statistics.median(moos_direct), statistics.median(goby_direct)
-                rows.append(("direct MOOS hop (baseline)", f"{base_moos:.3f}", f"{_percentile(moos_direct, .99):.3f}", ""))
-                rows.append(("direct Goby hop (baseline)", f"{base_goby:.3f}", f"{_percentile(goby_direct, .99):.3f}", ""))
+                rows.append(("direct MOOS hop (baseline)", f"{base_moos:.3f}", f"{percentile(moos_direct, .99):.3f}", ""))
+                rows.append(("direct Goby hop (baseline)", f"{base_goby:.3f}", f"{percentile(goby_direct, .99):.3f}", ""))
 
                 for tick_only, n in ((False, samples), (True, tick_samples)):
                     work = tmp / ("tick" if tick_only else "wake")
@@ -173,7 +169,7 @@ def run(samples: int, burst: int, tick_samples: int) -> list[tuple[str, str, str
                         base = base_moos + base_goby
                         for direction, values in (("MOOS->Goby", m2g), ("Goby->MOOS", g2m)):
                             median = statistics.median(values)
-                            rows.append((f"{label} {direction}", f"{median:.3f}", f"{_percentile(values, .99):.3f}",
+                            rows.append((f"{label} {direction}", f"{median:.3f}", f"{percentile(values, .99):.3f}",
                                          f"{median - base:+.3f}"))
                         if not tick_only:
                             rate, got = _throughput(burst, lambda t: poster.notify("BENCH_IN", t),

@@ -13,7 +13,6 @@ import argparse
 import contextlib
 import json
 import os
-import shutil
 import socket
 import statistics
 import subprocess
@@ -24,7 +23,9 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
+from bench.stats import median_p99
 from gateway.moos.factory import make_comms, pymoos_available
+from gateway.moos.testing import free_port, real_moos_skip_reason
 
 HERE = Path(__file__).resolve().parents[1]
 
@@ -164,8 +165,8 @@ def round_trip(kind: str, port: int, n: int, warmup: int) -> dict[str, float]:
             comms.notify("PING", -1.0)
         finally:
             comms.close(True)
-    samples.sort()
-    return {"median_us": statistics.median(samples) * 1e6, "p99_us": samples[int(len(samples) * 0.99)] * 1e6,
+    median, p99 = median_p99(samples)
+    return {"median_us": median * 1e6, "p99_us": p99 * 1e6,
             "handoff_us": statistics.median(handoffs) * 1e6}
 
 
@@ -195,20 +196,6 @@ def one_way(kind: str, port: int, n: int, subscribers: int = 1, payload: str | N
 
 
 # ---- DBs ---------------------------------------------------------------------------------------------------
-def private_netns() -> bool:
-    try:
-        lines = Path("/proc/self/net/dev").read_text().splitlines()[2:]
-    except OSError:
-        return False
-    return {line.split(":", 1)[0].strip() for line in lines} == {"lo"}
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @contextlib.contextmanager
 def start_db(kind: str) -> Iterator[tuple[int, int]]:
     """Yield (port, pid) of a running DB: ``ours`` (moos-db) or ``MOOSDB`` (the C++ one)."""
@@ -219,7 +206,7 @@ def start_db(kind: str) -> Iterator[tuple[int, int]]:
         line = proc.stdout.readline()  # type: ignore[union-attr]
         port = int(line.rsplit(":", 1)[1])
     else:
-        port = _free_port()
+        port = free_port()
         proc = subprocess.Popen(["MOOSDB", f"--moos_port={port}", "--moos_community=bench", "--moos_suicide_disable"],
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, text=True)
         deadline = time.monotonic() + 10
@@ -296,7 +283,7 @@ def main(argv: list[str] | None = None) -> int:
         return worker(args)
 
     combos = [("ours", "ours")]
-    real_db = shutil.which("MOOSDB") is not None and private_netns()
+    real_db = real_moos_skip_reason("MOOSDB") is None
     if real_db:
         combos.append(("MOOSDB", "ours"))
     if pymoos_available():

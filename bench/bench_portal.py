@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import statistics
 import sys
 import tempfile
 import time
@@ -19,6 +18,7 @@ from pathlib import Path
 
 from google.protobuf import text_format
 
+from bench.stats import median_p99
 from gateway.portal.protobuf.test_messages_pb2 import Sample, Widget
 from gateway.portal.testing import AppProcess, BrokerProcess, PortalClient
 from gateway.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
@@ -96,7 +96,7 @@ class Bench:
             if not self.client.poll_until(lambda: bool(self.pongs), 5):
                 raise RuntimeError(f"ping {i} lost")
         lat = sorted(self.report()["latencies_us"])
-        return statistics.median(lat), lat[int(len(lat) * 0.99) - 1], float(len(lat))
+        return (*median_p99(lat), float(len(lat)))
 
     def throughput(self, n: int, padding: int, window: int | None) -> tuple[float, int, float]:
         """(received msg/s, lost, published msg/s)."""
@@ -143,7 +143,8 @@ def call_soon_latency(n: int) -> tuple[float, float]:
             done.wait(5)
             time.sleep(0.0005)  # let the worker block in its poll again
     samples.sort()
-    return statistics.median(samples) * 1e6, samples[int(len(samples) * 0.99) - 1] * 1e6
+    med, p99 = median_p99(samples)
+    return med * 1e6, p99 * 1e6
 
 
 def in_process_costs(client: PortalClient, n: int) -> tuple[float, float]:

@@ -1,0 +1,19 @@
+"""Summary statistics shared by the benchmarks, so every table reports p99 the same way."""
+
+from __future__ import annotations
+
+import statistics
+from collections.abc import Sequence
+
+
+def percentile(values: Sequence[float], q: float) -> float:
+    """The nearest-rank ``q`` quantile (0..1) of ``values``."""
+    if not values:
+        raise ValueError("percentile of no values")
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, round(q * (len(ordered) - 1)))]
+
+
+def median_p99(values: Sequence[float]) -> tuple[float, float]:
+    """(median, p99) of ``values``."""
+    return statistics.median(values), percentile(values, 0.99)
