@@ -1,5 +1,6 @@
 """``frontseat-interface`` with the basic simulator driver preselected (Goby's generated wrapper script
-``goby_frontseat_interface_basic_simulator``): ``python -m frontseat.interface_basic_simulator --example_config``."""
+``goby_frontseat_interface_basic_simulator``): the console script ``frontseat-interface-basic-simulator``, or
+``python -m frontseat.interface_basic_simulator``. An already set ``FRONTSEAT_DRIVER_LIBRARY`` wins."""
 
 from __future__ import annotations
 

@@ -15,7 +15,7 @@ import time
 
 from ..logsetup import add_verbosity_argument, configure_logging
 from .client import comms
-from .clock import MoosClock
+from .clock import MAX_WARP, MoosClock
 from .tool_args import add_server_arguments, resolve_server, split_mission_file
 
 log = logging.getLogger(__name__)
@@ -36,6 +36,26 @@ def parse_assignment(text: str) -> tuple[str, float | str]:
     return name.strip(), value
 
 
+def adopt_db_time_warp(client: comms, clock: MoosClock) -> float:
+    """Give ``clock`` the connected DB's time warp, inferred from the DB time in its WELCOME, as uPokeDB does.
+
+    The DB stamps its WELCOME with its warped MOOS time (unix time x warp), so ``db_time / now`` is the warp,
+    rounded to 0.001. Used by moos-poke and moos-scope when neither ``--moos_time_warp`` nor the mission file
+    gives one. A skew already taken from the WELCOME (measured at the old warp) is re-based on the new warp.
+    Returns the warp now in force.
+    """
+    welcome = client.welcome
+    if welcome is None or welcome.db_time <= 0:
+        return clock.warp
+    now = time.time()
+    warp = min(MAX_WARP, max(0.001, round(welcome.db_time / now, 3)))
+    if warp != clock.warp:
+        clock.set_warp(warp)
+        if clock.skew != 0.0:  # time correction is on (remote DB or quiet): skew = DB time - our warped time
+            clock.skew = welcome.db_time - now * warp
+    return warp
+
+
 def _same(sent: float | str, msg: object) -> bool:
     if isinstance(sent, float):
         return msg.is_double() and msg.double() == sent  # type: ignore[attr-defined]
@@ -49,7 +69,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--confirm_timeout", type=float, default=3.0, help="seconds to wait for read-back")
     add_server_arguments(parser)
     add_verbosity_argument(parser)
-    args = parser.parse_args(argv)
+    args = parser.parse_intermixed_args(argv)  # options may sit between the mission file and VAR=value
     configure_logging(args.verbose, "moos-poke")
     mission, items = split_mission_file(args.items)
     try:
@@ -69,8 +89,8 @@ def main(argv: list[str] | None = None) -> int:
             log.error("cannot connect: %s", reason)
             print(f"moos-poke: cannot connect: {reason}", file=sys.stderr)
             return 1
-        if warp is None and client.welcome is not None:
-            clock.set_warp(max(0.001, round(client.welcome.db_time / time.time(), 3)))  # uPokeDB infers it too
+        if warp is None:
+            adopt_db_time_warp(client, clock)
         for name, _ in pokes:
             client.register(name, 0)
         for name, value in pokes:

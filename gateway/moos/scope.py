@@ -1,7 +1,9 @@
 """``moos-scope``: a live table of MOOS variables, in the spirit of uXMS.
 
-``moos-scope [mission.moos] VAR ... [--all] [--once | --duration S]``: shows each variable's value, source,
-time and community. ``--once`` prints one table as soon as every variable has been seen (or after
+``moos-scope [mission.moos] VAR ... [--all] [--once | --duration S]`` (options may come anywhere): shows each
+variable's value, source, time and community. Times are MOOS seconds since the scope started, on a clock at
+the DB's time warp (inferred from its WELCOME, as moos-poke does) unless ``--moos_time_warp`` or the mission
+file's ``MOOSTimeWarp`` names one. ``--once`` prints one table as soon as every variable has been seen (or after
 ``--timeout``); ``--duration`` refreshes the table for that many seconds; with neither it runs until Ctrl-C.
 """
 
@@ -18,6 +20,7 @@ from ..logsetup import add_verbosity_argument, configure_logging
 from .client import comms
 from .clock import MoosClock
 from .message import MoosMessage
+from .poke import adopt_db_time_warp
 from .tool_args import add_server_arguments, resolve_server, split_mission_file
 
 log = logging.getLogger(__name__)
@@ -35,16 +38,29 @@ def format_value(msg: MoosMessage | None, width: int = 40) -> str:
 
 
 def render_table(names: list[str], latest: dict[str, MoosMessage], start_time: float) -> str:
-    """The table uXMS prints: name, source, time (since scope start), community, value."""
-    rows = [f"  {'VarName':<24} {'(S)ource':<16} {'(T)ime':>10}  {'(C)ommunity':<12} VarValue",
-            f"  {'-' * 24} {'-' * 16} {'-' * 10}  {'-' * 12} {'-' * 20}"]
+    """The table uXMS prints: name, source, time (MOOS seconds since scope start), community, value.
+
+    Each column is as wide as its widest cell, so long names and sources (``goby::moos::Translator::10335``)
+    keep the columns aligned.
+    """
+    header = ("VarName", "(S)ource", "(T)ime", "(C)ommunity", "VarValue")
+    cells: list[tuple[str, str, str, str, str]] = []
     for name in names:
         msg = latest.get(name)
         if msg is None:
-            rows.append(f"  {name:<24} {'n/a':<16} {'n/a':>10}  {'n/a':<12} n/a")
-            continue
-        rows.append(f"  {name:<24} {msg.source():<16} {msg.time() - start_time:>10.2f}  "
-                    f"{msg.community():<12} {format_value(msg)}")
+            cells.append((name, "n/a", "n/a", "n/a", "n/a"))
+        else:
+            cells.append((name, msg.source(), f"{msg.time() - start_time:.2f}", msg.community(), format_value(msg)))
+    widths = [max(len(row[i]) for row in (header, *cells)) for i in range(4)]
+    widths.append(max(20, *(len(row[4]) for row in cells)) if cells else 20)
+
+    def line(row: tuple[str, ...]) -> str:
+        name, source, stamp, community, value = row
+        return (f"  {name:<{widths[0]}} {source:<{widths[1]}} {stamp:>{widths[2]}}  "
+                f"{community:<{widths[3]}} {value}").rstrip()
+
+    rows = [line(header), line(tuple("-" * w for w in widths))]
+    rows.extend(line(row) for row in cells)
     return "\n".join(rows)
 
 
@@ -60,7 +76,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--refresh", type=float, default=1.0, help="seconds between live refreshes")
     add_server_arguments(parser)
     add_verbosity_argument(parser)
-    args = parser.parse_args(argv)
+    args = parser.parse_intermixed_args(argv)  # `moos-scope mission.moos --once NAV_X` works
     configure_logging(args.verbose, "moos-scope")
     mission, names = split_mission_file(args.items)
     if not names and not args.all:
@@ -89,6 +105,8 @@ def main(argv: list[str] | None = None) -> int:
             reason = client.get_fatal_error() or f"no DB at {host}:{port} within {args.connect_timeout:g} s"
             print(f"moos-scope: cannot connect: {reason}", file=sys.stderr)
             return 1
+        if warp is None:  # neither --moos_time_warp nor MOOSTimeWarp: use the DB's, as moos-poke does
+            adopt_db_time_warp(client, clock)
         start = clock.time()
         if args.once:
             deadline = time.monotonic() + args.timeout

@@ -134,3 +134,90 @@ def test_moos_db_timeout_flag_drops_silent_clients(tmp_path: Path) -> None:
                 pass
             assert 0.5 < time.monotonic() - start < 8
         assert "seconds of silence" in db.log_path.read_text()
+
+
+def _scope_rows(out: str) -> dict[str, str]:
+    return {line.split()[0]: line for line in out.splitlines()[2:] if line.strip()}
+
+
+def test_scope_times_follow_the_db_time_warp(capsys: pytest.CaptureFixture[str]) -> None:
+    # the DB at warp 10 and no --moos_time_warp: scope (like poke) must run its clock at the DB's warp,
+    # otherwise its start time is unix time and a message's time shows as ~1.6e10 s
+    with running_moosdb(warp=10.0) as db, connected_comms(db.port, "watch", ["W_X"]) as watch:
+        assert poke.main(["W_X=1", f"--port={db.port}"]) == 0
+        sent = collect_mail(watch, ["W_X"])[0]
+        assert abs(sent.time() - 10 * time.time()) < 60  # poke stamps in the DB's (warped) time
+        capsys.readouterr()
+        assert scope.main(["W_X", "--once", f"--port={db.port}"]) == 0
+        stamp = float(_scope_rows(capsys.readouterr().out)["W_X"].split()[2])
+        assert -60.0 < stamp <= 0.5  # written a moment (x10) before the scope started
+        # an explicit warp still wins over the DB's
+        assert scope.main(["W_X", "--once", f"--port={db.port}", "--moos_time_warp=1"]) == 0
+        stamp = float(_scope_rows(capsys.readouterr().out)["W_X"].split()[2])
+        assert stamp > 1e9
+
+
+def test_adopt_db_time_warp_rebases_a_skew() -> None:
+    from gateway.moos.client import comms
+    from gateway.moos.clock import MoosClock
+
+    with running_moosdb(warp=4.0) as db:
+        clock = MoosClock(1.0)
+        client = comms(clock=clock)
+        client.set_quiet(True)  # quiet: the client takes the DB's skew even on the same host
+        client.run("127.0.0.1", db.port, "warp-probe")
+        try:
+            assert client.wait_until_connected(10_000)
+            assert abs(clock.skew) > 1e9  # measured at warp 1 against a warp-4 DB
+            assert poke.adopt_db_time_warp(client, clock) == 4.0 and clock.warp == 4.0
+            assert abs(clock.time() - 4 * time.time()) < 5
+        finally:
+            client.close(True)
+
+
+def test_options_may_come_between_the_positionals(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    with running_moosdb() as db:
+        mission = tmp_path / "m.moos"
+        mission.write_text(f"ServerHost = 127.0.0.1\nServerPort = {db.port}\n")
+        assert poke.main([str(mission), "--name=pokerA", "IM_A=1", "--confirm_timeout=5", "IM_B:=two"]) == 0
+        assert capsys.readouterr().out.count(" ok") == 2
+        assert scope.main([str(mission), "--once", "IM_A", "--timeout=5", "IM_B"]) == 0
+        rows = _scope_rows(capsys.readouterr().out)
+        assert "pokerA" in rows["IM_A"] and rows["IM_B"].rstrip().endswith('"two"')
+
+
+def test_scope_columns_fit_long_names_and_sources(capsys: pytest.CaptureFixture[str]) -> None:
+    long_source = "goby::moos::Translator::10335"
+    long_name = "A_RATHER_LONG_VARIABLE_NAME_INDEED"
+    with running_moosdb() as db, connected_comms(db.port, long_source) as pub:
+        pub.notify(long_name, "x")
+        pub.notify("S", 1.0)
+        assert scope.main([long_name, "S", "--once", f"--port={db.port}"]) == 0
+        lines = capsys.readouterr().out.splitlines()
+        header, rows = lines[0], _scope_rows("\n".join(lines))
+        assert set(rows) == {long_name, "S"}
+        for row in rows.values():
+            fields = row.split()
+            assert fields[1] == long_source  # nothing ran into its neighbour
+            assert row.index(long_source) == header.index("(S)ource")
+            assert row.index(" moos ") + 1 == header.index("(C)ommunity")
+            time_end = row.index(fields[2]) + len(fields[2])
+            assert time_end == header.index("(T)ime") + len("(T)ime")  # right-aligned under its heading
+        assert rows[long_name].rstrip().endswith('"x"') and rows["S"].rstrip().endswith(" 1")
+        assert rows[long_name].index('"x"') == rows["S"].index("1", header.index("VarValue")) == \
+            header.index("VarValue")
+
+
+def test_console_scripts_against_a_warped_db_process(tmp_path: Path) -> None:
+    # the reviewer's repro: moos-db at warp 10, moos-poke, then moos-scope with a mission file and --once between
+    with MoosDBProcess(tmp_path, warp=10.0) as db:
+        mission = tmp_path / "mission.moos"
+        mission.write_text(f"ServerHost = 127.0.0.1\nServerPort = {db.port}\n")
+        run = subprocess.run([str(BIN / "moos-poke"), "--port", str(db.port), "FOO=1"], capture_output=True,
+                             text=True, timeout=30)
+        assert run.returncode == 0, run.stderr
+        run = subprocess.run([str(BIN / "moos-scope"), str(mission), "--once", "FOO"], capture_output=True,
+                             text=True, timeout=30)
+        assert run.returncode == 0, run.stderr
+        stamp = float(_scope_rows(run.stdout)["FOO"].split()[2])
+        assert -60.0 < stamp <= 0.5
