@@ -159,16 +159,32 @@ def loiter_phases(record: MissionRecord, end_time: float | None = None) -> list[
     return phases
 
 
+def normalized_heading(heading: float) -> float:
+    """A heading in [0, 360): the basic simulator, like Goby's, never wraps NAV_HEADING (540 is 180)."""
+    wrapped = heading % 360.0
+    return 0.0 if wrapped >= 360.0 else wrapped  # -1e-15 % 360 is 360.0
+
+
 @dataclass
 class WaypointApproach:
-    """How the vehicle reacted to WAYPOINTS: heading error to the first waypoint and range change."""
+    """How the vehicle reacted to WAYPOINTS, over the WAYPOINTS phase (until the next command or the end).
+
+    ``t_end`` is when the phase ended; ``ended_by_command`` says whether another command ended it (else the
+    record, or ``window_s``, did).
+    """
 
     t_command: float
+    t_end: float
+    ended_by_command: bool
     waypoint: Point
     start_range: float
     min_range: float
     start_heading_error: float | None
     min_heading_error: float | None
+
+    @property
+    def duration(self) -> float:
+        return self.t_end - self.t_command
 
 
 def bhv_waypoints(bhv_file: Path) -> list[Point]:
@@ -190,25 +206,35 @@ def _angle_error(a: float, b: float) -> float:
 
 
 def waypoint_approach(
-    record: MissionRecord, waypoints: list[Point], window_s: float = 200.0
+    record: MissionRecord, waypoints: list[Point], window_s: float | None = None
 ) -> WaypointApproach | None:
-    """The vehicle's reaction in the ``window_s`` after the WAYPOINTS command reached MOOS."""
-    commands = [c for c in command_effects(record) if c.state == "WAYPOINTS"]
-    if not commands:
+    """The vehicle's reaction to the first WAYPOINTS command, from when it reached MOOS until the next command
+    reached MOOS (or the record ends; at most ``window_s`` when given)."""
+    effects = command_effects(record)
+    index = next((i for i, c in enumerate(effects) if c.state == "WAYPOINTS"), None)
+    if index is None:
         return None
-    seglists = [e for e in record.events_named("VIEW_SEGLIST", source="moos") if e.t >= commands[0].t]
+    t0 = effects[index].t
+    next_command = effects[index + 1].t if index + 1 < len(effects) else None
+    all_nav = record.snapshot()[0]
+    t_end = next_command if next_command is not None else (all_nav[-1].t if all_nav else t0)
+    ended_by_command = next_command is not None
+    if window_s is not None and t_end > t0 + window_s:
+        t_end, ended_by_command = t0 + window_s, False
+    seglists = [e for e in record.events_named("VIEW_SEGLIST", source="moos") if t0 <= e.t <= t_end]
     points = parse_points(seglists[0].value) if seglists else []
     target = (points or waypoints or [None])[0]
     if target is None:
         return None
-    t0 = commands[0].t
-    nav = [s for s in record.snapshot()[0] if t0 <= s.t <= t0 + window_s]
+    nav = [s for s in all_nav if t0 <= s.t <= t_end]
     if not nav:
         return None
     ranges = [math.hypot(target[0] - s.x, target[1] - s.y) for s in nav]
     errors = [_angle_error(s.heading, _bearing((s.x, s.y), target)) for s in nav if s.heading is not None]
     return WaypointApproach(
         t_command=t0,
+        t_end=t_end,
+        ended_by_command=ended_by_command,
         waypoint=target,
         start_range=ranges[0],
         min_range=min(ranges),

@@ -1,7 +1,8 @@
 """``python -m launch.usv.demo`` (``make demo``): run the USV mission headless and show what the vehicle did.
 
 Starts every process of ``launch/usv/usv.launch`` with generated configs, lets the shore script command
-the vehicle (loiter on a hexagon, then the waypoints, then an octagon of radius 400), records the track
+the vehicle (loiter on a hexagon, then the waypoints, then an octagon of radius 400; ``--schedule none``: no
+commands, the user sends them with the printed ``usv-command`` lines), records the track
 through a MOOS client and a portal subscriber, then writes ``track.csv``, ``events.csv`` and ``track.png``
 into the output directory and prints a summary. Exit status 0 only if the mission ran and every process
 stopped cleanly.
@@ -11,6 +12,8 @@ from __future__ import annotations
 
 import argparse
 import logging
+import math
+import shlex
 import shutil
 import signal
 import socket
@@ -21,11 +24,12 @@ from pathlib import Path
 
 from gateway.logsetup import add_verbosity_argument, configure_logging
 from launch.config import free_tcp_port
-from launch.errors import LaunchError
+from launch.errors import ConfigError, LaunchError
 from launch.usv.analysis import bhv_waypoints, command_effects, loiter_phases, transitions
 from launch.usv.mission import MissionResult, UsvMission, choose_program
 from launch.usv.plot import write_track_png
 from launch.usv.settings import DEFAULT_SCHEDULE, KAUAI_ORIGIN, UsvSettings
+from launch.usv.shore import SCHEDULE_HELP, parse_schedule
 from launch.usv.summary import progress_line, summary_text
 
 log = logging.getLogger(__name__)
@@ -35,21 +39,53 @@ DEFAULT_WARP = 20
 MAX_SOCKET_BASE = 90  # AF_UNIX paths are limited to ~107 bytes
 
 
+def _warp(text: str) -> int:
+    try:
+        warp = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if warp < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, not {warp}")
+    return warp
+
+
+def _origin(text: str) -> tuple[float, float]:
+    """``LAT,LON`` in degrees."""
+    parts = text.split(",")
+    try:
+        lat, lon = (float(v) for v in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not LAT,LON in degrees (e.g. 21.590491,-159.534166)") from None
+    if not (math.isfinite(lat) and math.isfinite(lon) and -90 <= lat <= 90 and -180 <= lon <= 180):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a latitude,longitude (-90..90, -180..180)")
+    return lat, lon
+
+
+def _schedule(text: str) -> str:
+    """The shore's own parser, so a schedule the shore would refuse is refused before anything starts."""
+    try:
+        parse_schedule(text)
+    except ConfigError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="python -m launch.usv.demo", description=__doc__.split("\n\n")[0])
     parser.add_argument("--duration", type=float, default=DEFAULT_DURATION_S,
                         help=f"sim seconds to run after the helm takes command (default {DEFAULT_DURATION_S:g}; "
                         "0 = until Ctrl-C)")
     parser.add_argument("--forever", action="store_true", help="run until Ctrl-C or SIGTERM (same as --duration 0)")
-    parser.add_argument("--warp", type=int, default=DEFAULT_WARP, help=f"time warp (default {DEFAULT_WARP})")
+    parser.add_argument("--warp", type=_warp, default=DEFAULT_WARP, help=f"time warp (default {DEFAULT_WARP})")
     parser.add_argument("--out", type=Path, default=Path("out"), help="output directory (default ./out)")
     parser.add_argument("--moosdb", choices=("auto", "real", "ours"), default="auto",
                         help="MOOSDB when on PATH (auto), force it (real) or our moos-db (ours)")
     parser.add_argument("--helm", choices=("auto", "real", "ours"), default="auto",
                         help="pHelmIvP when on PATH (auto), force it (real) or our ivp-helm (ours)")
-    parser.add_argument("--schedule", default=DEFAULT_SCHEDULE,
-                        help=f"shore commands, T:waypoints / T:polygon:SIDES:RADIUS (default {DEFAULT_SCHEDULE})")
-    parser.add_argument("--origin", default=f"{KAUAI_ORIGIN[0]},{KAUAI_ORIGIN[1]}", help="lat,lon of the local grid")
+    parser.add_argument("--schedule", type=_schedule, default=DEFAULT_SCHEDULE,
+                        help=f"shore commands: {SCHEDULE_HELP} (default {DEFAULT_SCHEDULE})")
+    parser.add_argument("--origin", type=_origin, default=f"{KAUAI_ORIGIN[0]},{KAUAI_ORIGIN[1]}", metavar="LAT,LON",
+                        help="lat,lon of the local grid (default %(default)s)")
     parser.add_argument("--moos-port", type=int, default=0, help="MOOSDB port (default 9001 if free)")
     parser.add_argument("--sim-port", type=int, default=0, help="frontseat simulator port (default 55001 if free)")
     add_verbosity_argument(parser)
@@ -68,7 +104,7 @@ def _port(requested: int, preferred: int) -> int:
 
 
 def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> UsvSettings:
-    lat, lon = (float(v) for v in args.origin.split(","))
+    lat, lon = args.origin
     return UsvSettings(
         run_dir=run_dir,
         warp=args.warp,
@@ -81,6 +117,43 @@ def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> 
         schedule=args.schedule,
         socket_name=str(socket_dir / "goby_usv"),
     )
+
+
+# What the usv_command config depends on (besides the run directory and warp, which are always given).
+_COMMAND_VARS = ("lat_origin", "lon_origin", "platform")
+
+
+def command_env(settings: UsvSettings) -> dict[str, str]:
+    """The USV_* variables that make ``python -m launch.usv.config usv_command`` talk to this run's broker."""
+    env = settings.to_env()
+    default = UsvSettings()
+    out = {"USV_RUN_DIR": env["USV_RUN_DIR"], "USV_WARP": env["USV_WARP"]}
+    for name in _COMMAND_VARS:
+        if getattr(settings, name) != getattr(default, name):
+            var = f"USV_{name.upper()}"
+            out[var] = env[var]
+    if settings.ipc_base != settings.replace(socket_name="").ipc_base:
+        out["USV_SOCKET_NAME"] = env["USV_SOCKET_NAME"]
+    return out
+
+
+def command_lines(settings: UsvSettings) -> list[str]:
+    """Bash lines that send commands to this run from another terminal.
+
+    The variables are exported on a line of their own: a ``VAR=value cmd <(...)`` prefix reaches ``cmd`` but
+    not the ``<(...)`` process substitution that generates the config. The programs are named by absolute path
+    (this interpreter's bin directory), so the lines work without an activated virtualenv.
+    """
+    bin_dir = Path(sys.executable).parent
+    tool = bin_dir / "usv-command"
+    usv_command = str(tool) if tool.exists() else (shutil.which("usv-command") or "usv-command")
+    config = f"<({shlex.quote(sys.executable)} -m launch.usv.config usv_command)"
+    exports = " ".join(f"{var}={shlex.quote(value)}" for var, value in command_env(settings).items())
+    return [
+        f"export {exports}",
+        f"{shlex.quote(usv_command)} waypoints {config}",
+        f"{shlex.quote(usv_command)} polygon --sides 8 --radius 400 {config}",
+    ]
 
 
 def write_outputs(result: MissionResult, settings: UsvSettings, out: Path) -> tuple[Path, Path]:
@@ -104,8 +177,11 @@ def run_demo(args: argparse.Namespace) -> int:
     socket_dir = run_dir if len(str(run_dir)) < MAX_SOCKET_BASE else Path(tempfile.mkdtemp(prefix="usv-", dir="/tmp"))
     settings = make_settings(args, run_dir, socket_dir)
     duration = args.duration if args.duration > 0 and not args.forever else None
+    planned = len(parse_schedule(settings.schedule))
     print(f"USV mission: {settings.moosdb}, {settings.helm}, warp {settings.warp}, MOOS port {settings.moos_port}, "
           f"simulator port {settings.sim_port}; logs in {settings.log_dir}", flush=True)
+    print(f"shore schedule: {settings.schedule}" + ("" if planned else " (no commands: send them with usv-command)"),
+          flush=True)
     mission = UsvMission(settings)
     previous = {s: signal.signal(s, lambda *_: mission.stop_event.set()) for s in (signal.SIGINT, signal.SIGTERM)}
     failure = None
@@ -113,6 +189,9 @@ def run_demo(args: argparse.Namespace) -> int:
     try:
         mission.start()
         print("waiting for the frontseat interface to reach COMMAND ...", flush=True)
+        if mission.wait_for_command() is not None:
+            print("the vehicle is under helm command. To send commands to THIS run, in another terminal (bash):\n"
+                  + "\n".join(f"  {line}" for line in command_lines(settings)), flush=True)
         mission.run(duration, lambda t: print(progress_line(mission.record, t, duration), flush=True))
     except LaunchError as exc:
         failure = str(exc)

@@ -8,13 +8,15 @@ this process, rather than starting ``usv-command`` each time, keeps the commands
 process start costs a second or more, which is tens of simulated seconds at high warp. The script stays up
 until stopped.
 
-Schedule format: comma-separated ``T:waypoints`` or ``T:polygon:SIDES:RADIUS`` entries, T in sim seconds.
+Schedule format: comma-separated ``T:waypoints`` or ``T:polygon:SIDES:RADIUS`` entries, T in sim seconds;
+``none`` for no commands at all (the operator then sends every command with ``usv-command``).
 """
 
 from __future__ import annotations
 
 import argparse
 import logging
+import math
 import os
 import sys
 import time
@@ -60,12 +62,24 @@ class ScheduledCommand:
         return command
 
 
+NO_SCHEDULE = "none"
+SCHEDULE_HELP = f"T:waypoints / T:polygon:SIDES:RADIUS, comma-separated, T in sim seconds; {NO_SCHEDULE} for no commands"
+
+
 def parse_schedule(text: str) -> list[ScheduledCommand]:
-    """Parse ``0:polygon:6:200,500:waypoints``; ConfigError names the bad entry."""
+    """Parse ``0:polygon:6:200,500:waypoints`` (or ``none``: no commands); ConfigError names the bad entry.
+
+    Every command is also checked against the USVCommand's DCCL bounds, so a plan that could not be sent
+    is refused before anything starts.
+    """
+    if text.strip().lower() == NO_SCHEDULE:
+        return []
+    if not text.strip():
+        raise ConfigError(f"empty schedule {text!r}: give {SCHEDULE_HELP}")
     plan = []
     for item in (part.strip() for part in text.split(",")):
         if not item:
-            continue
+            raise ConfigError(f"empty entry in schedule {text!r} (two commas, or one at an end)")
         fields = item.split(":")
         try:
             at = float(fields[0])
@@ -80,9 +94,14 @@ def parse_schedule(text: str) -> list[ScheduledCommand]:
             raise ConfigError(
                 f"bad schedule entry {item!r}: use T:waypoints or T:polygon:SIDES:RADIUS (T in sim seconds)"
             ) from None
-        if at < 0:
-            raise ConfigError(f"bad schedule entry {item!r}: time must be >= 0")
-        plan.append(ScheduledCommand(at, args))
+        if not math.isfinite(at) or at < 0:
+            raise ConfigError(f"bad schedule entry {item!r}: time must be a number >= 0")
+        command = ScheduledCommand(at, args)
+        try:
+            check_dccl_bounds(command.to_message(0.0))
+        except DcclBoundsError as error:
+            raise ConfigError(f"bad schedule entry {item!r}: {error}") from None
+        plan.append(command)
     return sorted(plan, key=lambda c: c.at)
 
 
@@ -97,8 +116,11 @@ class ShoreOperator(SingleThreadApplication):
         self._sent: dict[float, ScheduledCommand] = {}
         self.interprocess().subscribe(frontseat_groups.status, InterfaceStatus, self._on_status)
         self.interprocess().subscribe(usv_groups.usv_command_ack, USVCommandAck, self._on_ack)
-        print(f"shore: {len(plan)} commands planned: "
-              + "; ".join(f"t={c.at:g} s {c.describe()}" for c in plan), flush=True)
+        if plan:
+            print(f"shore: {len(plan)} commands planned: "
+                  + "; ".join(f"t={c.at:g} s {c.describe()}" for c in plan), flush=True)
+        else:
+            print("shore: no commands planned (schedule none); send them with usv-command", flush=True)
 
     def _sim_elapsed(self) -> float:
         return 0.0 if self._t0 is None else (time.monotonic() - self._t0) * self._warp
@@ -136,17 +158,14 @@ class ShoreOperator(SingleThreadApplication):
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0])
+    # An empty USV_SHORE_SCHEDULE counts as unset (as every USV_* variable does): no commands is spelled "none".
     parser.add_argument("--schedule", default=os.environ.get("USV_SHORE_SCHEDULE") or DEFAULT_SCHEDULE,
-                        help="T:waypoints / T:polygon:SIDES:RADIUS, comma-separated "
-                        f"(default $USV_SHORE_SCHEDULE or {DEFAULT_SCHEDULE})")
+                        help=f"{SCHEDULE_HELP} (default $USV_SHORE_SCHEDULE or {DEFAULT_SCHEDULE})")
     args, goby_argv = parser.parse_known_args(argv)
     try:
         plan = parse_schedule(args.schedule)
     except ConfigError as exc:
         print(f"{PROG}: {exc}", file=sys.stderr)
-        return 2
-    if not plan:
-        print(f"{PROG}: empty schedule (--schedule or USV_SHORE_SCHEDULE)", file=sys.stderr)
         return 2
     return run_application(lambda cfg: ShoreOperator(cfg, plan), CommandTool, goby_argv, prog=PROG)
 

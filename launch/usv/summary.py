@@ -9,6 +9,7 @@ from launch.usv.analysis import (
     helm_timeline,
     interface_timeline,
     loiter_phases,
+    normalized_heading,
     transitions,
     waypoint_approach,
 )
@@ -23,7 +24,12 @@ def progress_line(record: MissionRecord, elapsed: float, duration: float | None)
     iface = interface_timeline(record)
     helm = helm_timeline(record)
     deploy = transitions(record.events_named("DEPLOY_STATE", source="moos"))
-    where = f"x={nav[-1].x:7.1f} y={nav[-1].y:7.1f} hdg={nav[-1].heading or 0:5.1f}" if nav else "no nav yet"
+    if nav:
+        heading = nav[-1].heading
+        hdg = "    ?" if heading is None else f"{normalized_heading(heading):5.1f}"
+        where = f"x={nav[-1].x:7.1f} y={nav[-1].y:7.1f} hdg={hdg}"
+    else:
+        where = "no nav yet"
     total = f"/{duration:.0f}" if duration else ""
     return (
         f"t={elapsed:6.0f}{total} s sim | interface {iface[-1][1] if iface else '?'} | helm "
@@ -68,14 +74,19 @@ def summary_text(result: MissionResult, waypoints: list[Point]) -> str:
         wx, wy = approach.waypoint
         heading = (f"heading error {approach.start_heading_error:.0f} -> min {approach.min_heading_error:.0f} deg"
                    if approach.min_heading_error is not None else "no heading data")
+        until = "until the next command" if approach.ended_by_command else "until the end of the run"
         lines.append(
-            f"waypoints (t={approach.t_command:.0f} s): first waypoint ({wx:.0f},{wy:.0f}), range "
-            f"{approach.start_range:.0f} -> min {approach.min_range:.0f} m in 200 s, {heading}"
+            f"waypoints phase t={approach.t_command:.0f}..{approach.t_end:.0f} s ({approach.duration:.0f} s, {until}): "
+            f"first waypoint ({wx:.0f},{wy:.0f}), range {approach.start_range:.0f} -> min {approach.min_range:.0f} m, "
+            f"{heading}"
         )
     nav = record.snapshot()[0]
     if len(nav) > 1:
         distance = sum(math.hypot(b.x - a.x, b.y - a.y) for a, b in zip(nav, nav[1:], strict=False))
-        lines.append(f"track: {len(nav)} fixes over {nav[-1].t - nav[0].t:.0f} s, {distance:.0f} m travelled")
+        last = nav[-1]
+        final_heading = "" if last.heading is None else f" heading {normalized_heading(last.heading):.0f} deg"
+        lines.append(f"track: {len(nav)} fixes over {last.t - nav[0].t:.0f} s, {distance:.0f} m travelled; "
+                     f"last fix ({last.x:.0f},{last.y:.0f}){final_heading}")
     clean = [o for o in result.outcomes if o.clean]
     lines.append(f"processes: {len(clean)}/{len(result.outcomes)} exited cleanly"
                  + "".join(f"\n  NOT clean: {o.name} (exit status {o.returncode}, log {o.log_path})"

@@ -7,11 +7,19 @@ import math
 
 import pytest
 
-from launch.usv.analysis import bhv_waypoints, command_effects, loiter_phases, waypoint_approach
+from launch.usv.analysis import (
+    bhv_waypoints,
+    command_effects,
+    loiter_phases,
+    normalized_heading,
+    waypoint_approach,
+)
 from launch.usv.geometry import parse_points, parse_polygon, radial_polygon
+from launch.usv.mission import MissionResult
 from launch.usv.plot import write_track_png
 from launch.usv.record import MissionRecord, shifted
 from launch.usv.settings import UsvSettings
+from launch.usv.summary import progress_line, summary_text
 
 
 def test_radial_polygon_matches_moos_ivp_vertex_order():
@@ -93,6 +101,66 @@ def test_waypoint_approach_measures_the_turn_and_the_closing_range():
     assert approach.waypoint == (134, 33)
     assert approach.min_heading_error < 1
     assert approach.min_range < approach.start_range - 100
+    assert (approach.t_command, approach.t_end, approach.duration) == (300, 400, 100)
+    assert approach.ended_by_command
+
+
+def _short_waypoints_phase() -> MissionRecord:
+    """WAYPOINTS for only 50 s, halfway to (134, 33), then POLYGON; the vehicle passes over the waypoint later."""
+    record = MissionRecord()
+    record.add_event(0, "moos", "DEPLOY_STATE", "WAYPOINTS", "gw")
+    for t in range(0, 50):  # from (0, 190) halfway to the waypoint
+        frac = t / 100
+        record.add_nav(t, "NAV_X", 134 * frac)
+        record.add_nav(t, "NAV_Y", 190 + (33 - 190) * frac)
+        record.add_nav(t, "NAV_HEADING", 140.0)
+    record.add_event(50, "moos", "POLYGON_UPDATES", "polygon=radial::x=0,y=0,radius=200,pts=6", "gw")
+    record.add_event(50, "moos", "DEPLOY_STATE", "POLYGON", "gw")
+    for t in range(50, 250):  # drifts on over the waypoint and past it, under the polygon command
+        frac = t / 100
+        record.add_nav(t, "NAV_X", 134 * frac)
+        record.add_nav(t, "NAV_Y", 190 + (33 - 190) * frac)
+        record.add_nav(t, "NAV_HEADING", 140.0)
+    return record
+
+
+def test_waypoint_approach_is_limited_to_the_waypoints_phase():
+    record = _short_waypoints_phase()
+    approach = waypoint_approach(record, [(134, 33)])
+    assert (approach.t_command, approach.t_end, approach.duration) == (0, 50, 50)
+    assert approach.ended_by_command
+    start = math.hypot(134, 190 - 33)
+    assert approach.start_range == pytest.approx(start)
+    # Only the phase counts: halfway there at its end, although the vehicle passed over the waypoint at t=100.
+    assert approach.min_range == pytest.approx(start * 0.5, abs=2)
+    text = summary_text(MissionResult(record, 0.0), [(134, 33)])
+    assert "waypoints phase t=0..50 s (50 s, until the next command)" in text, text
+    assert "in 200 s" not in text and f"range {start:.0f} -> min {start * 0.5:.0f} m" in text, text
+    # A last phase runs to the end of the record.
+    only = MissionRecord()
+    only.add_event(10, "moos", "DEPLOY_STATE", "WAYPOINTS", "gw")
+    for t in range(10, 80):
+        only.add_nav(t, "NAV_X", 0.0)
+        only.add_nav(t, "NAV_Y", float(t))
+    approach = waypoint_approach(only, [(0, 100)])
+    assert (approach.t_end, approach.ended_by_command) == (79, False)
+    assert "(69 s, until the end of the run)" in summary_text(MissionResult(only, 0.0), [(0, 100)])
+
+
+def test_headings_are_shown_normalised_and_kept_raw_in_track_csv(tmp_path):
+    assert [normalized_heading(h) for h in (0, 359.5, 360, 540, 765, -90, -1e-15)] == [0, 359.5, 0, 180, 45, 270, 0]
+    record = MissionRecord()
+    record.add_event(0, "moos", "DEPLOY_STATE", "WAYPOINTS", "gw")
+    for t, heading in ((0, 400.0), (1, 540.0)):  # the basic simulator never wraps NAV_HEADING
+        record.add_nav(t, "NAV_X", float(t))
+        record.add_nav(t, "NAV_Y", 0.0)
+        record.add_nav(t, "NAV_HEADING", heading)
+    line = progress_line(record, 1.0, None)
+    assert "hdg=180.0" in line and "540" not in line, line
+    text = summary_text(MissionResult(record, 0.0), [(100, 0)])
+    assert "last fix (1,0) heading 180 deg" in text and "540" not in text, text
+    record.write_csv(tmp_path / "track.csv")
+    assert [r["heading"] for r in csv.DictReader(open(tmp_path / "track.csv"))] == ["400.00", "540.00"]
 
 
 def test_outputs_csv_and_png(tmp_path):

@@ -17,6 +17,7 @@ from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from launch.errors import ConfigError
 from launch.launchfile import parse_file
 from launch.usv.config import GENERATORS, generate, write_moos_file
+from launch.usv.demo import command_env, command_lines
 from launch.usv.mission import LAUNCH_FILE, choose_program
 from launch.usv.settings import UsvSettings
 from launch.usv.shore import parse_schedule
@@ -108,9 +109,30 @@ def test_schedule_parsing():
         (500.0, ("waypoints",)),
         (800.0, ("polygon", "--sides", "8", "--radius", "400")),
     ]
-    for bad in ("x:waypoints", "10:polygon:6", "10:circle", "-5:waypoints"):
+    for bad in ("x:waypoints", "10:polygon:6", "10:circle", "-5:waypoints", "10:loiter", "nan:waypoints",
+                "0:polygon:2:200", "0:polygon:6:5000"):  # the last two are outside the USVCommand's DCCL bounds
         with pytest.raises(ConfigError, match="bad schedule entry"):
             parse_schedule(bad)
+
+
+def test_an_explicitly_empty_schedule_is_none_and_blank_ones_are_refused():
+    assert parse_schedule("none") == [] and parse_schedule(" None ") == []
+    for blank in ("", " "):
+        with pytest.raises(ConfigError, match="empty schedule .* none for no commands"):
+            parse_schedule(blank)
+    for gap in ("0:waypoints,,500:waypoints", "0:waypoints,"):
+        with pytest.raises(ConfigError, match="empty entry"):
+            parse_schedule(gap)
+
+
+def test_the_shore_refuses_a_bad_schedule_and_runs_with_none(tmp_path):
+    bad = subprocess.run([sys.executable, "-m", "launch.usv.shore", "--schedule", "10:loiter"],
+                         capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and "bad schedule entry '10:loiter'" in bad.stderr, bad.stderr
+    # USV_SHORE_SCHEDULE=none reaches the shore as none (an empty value would mean "unset": the default plan).
+    env = UsvSettings(run_dir=tmp_path, schedule="none").to_env()
+    assert UsvSettings.from_env(env).schedule == "none"
+    assert parse_schedule(UsvSettings.from_env(env | {"USV_SHORE_SCHEDULE": ""}).schedule) != []
 
 
 def test_choosing_real_or_our_programs(monkeypatch):
@@ -119,3 +141,19 @@ def test_choosing_real_or_our_programs(monkeypatch):
     assert choose_program("ours", "MOOSDB", "moos-db") == "moos-db"
     with pytest.raises(ConfigError, match="MOOSDB was asked for but is not on PATH"):
         choose_program("real", "MOOSDB", "moos-db")
+
+
+@pytest.mark.parametrize("long_run_dir", [False, True], ids=["socket-in-run-dir", "socket-elsewhere"])
+def test_the_printed_command_environment_reproduces_the_runs_usv_command_config(tmp_path, long_run_dir):
+    run_dir = tmp_path / ("x" * 90 if long_run_dir else "") / "run"
+    socket_name = str(tmp_path / "s" / "goby_usv") if long_run_dir else str(run_dir / "goby_usv")
+    settings = UsvSettings(run_dir=run_dir, warp=37, lat_origin=41.5, lon_origin=-70.7, moos_port=9123,
+                           sim_port=55123, socket_name=socket_name)
+    env = command_env(settings)
+    assert ("USV_SOCKET_NAME" in env) == long_run_dir
+    # What a user's shell rebuilds from the exported variables alone (nothing else of the run's environment).
+    assert generate("usv_command", UsvSettings.from_env(env)) == generate("usv_command", settings)
+    export, waypoints, polygon = command_lines(settings)
+    assert export.startswith("export USV_RUN_DIR=") and "USV_WARP=37" in export
+    assert waypoints.split()[1:] == ["waypoints", "<(" + sys.executable, "-m", "launch.usv.config", "usv_command)"]
+    assert "polygon --sides 8 --radius 400 <(" in polygon

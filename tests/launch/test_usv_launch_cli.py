@@ -14,6 +14,8 @@ import threading
 import time
 from pathlib import Path
 
+import pytest
+
 from launch.config import free_tcp_port
 from launch.launcher import child_environment
 from launch.usv.mission import LAUNCH_FILE
@@ -143,3 +145,70 @@ def test_demo_names_a_component_that_dies_and_exits_non_zero(tmp_path):
     assert "FAILED: process 'usv.frontseat-sim' died" in text  # the summary says so too
     assert "=== USV mission summary" in text
     assert (tmp_path / "o" / "track.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--origin", "abc"], "argument --origin: 'abc' is not LAT,LON"),
+        (["--origin", "95,10"], "argument --origin: '95,10' is not a latitude,longitude"),
+        (["--schedule", "10:loiter"], "argument --schedule: bad schedule entry '10:loiter'"),
+        (["--schedule", " "], "argument --schedule: empty schedule ' ': give"),
+        (["--schedule", ""], "argument --schedule: empty schedule '': give"),
+        (["--schedule", "0:polygon:6:200,800:polygon:12:400"], "argument --schedule: bad schedule entry '800:polygon:12:400': USVCommand.polygon_sides=12 is outside"),
+        (["--warp", "0"], "argument --warp: must be >= 1"),
+    ],
+)
+def test_demo_refuses_bad_arguments_before_starting_anything(tmp_path, args, message):
+    out_dir = tmp_path / "o"
+    proc = subprocess.run(
+        [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--moos-port", str(free_tcp_port()),
+         "--sim-port", str(free_tcp_port()), *args],
+        capture_output=True, text=True, timeout=60,
+    )
+    assert proc.returncode == 2, proc.stdout + proc.stderr
+    assert "python -m launch.usv.demo: error: " + message in proc.stderr, proc.stderr
+    assert "Traceback" not in proc.stderr and "Launched" not in proc.stdout, proc.stdout + proc.stderr
+    assert not out_dir.exists()  # nothing ran: no run directory, no logs
+
+
+def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(tmp_path):
+    out_dir = tmp_path / "o"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--forever", "--warp", "20",
+         "--schedule", "none", "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_tcp_port()),
+         "--sim-port", str(free_tcp_port())],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+    out = OutputReader(proc)
+    sent: subprocess.CompletedProcess[str] | None = None
+    try:
+        block = out.wait_for(r"To send commands to THIS run, in another terminal \(bash\):\n"
+                             r"  (export .*)\n  (.* waypoints .*)\n  (.* polygon .*)\n")
+        export, waypoints = block.group(1), block.group(2)
+        out.wait_for(r"^t=\s*\d+ s sim \| interface INTERFACE_COMMAND \| helm DRIVE")
+        # The user's other terminal: none of the run's USV_* variables, another directory, the printed lines only.
+        user_env = {k: v for k, v in os.environ.items() if not k.startswith("USV_")}
+        sent = subprocess.run(["bash", "-c", f"{export}\n{waypoints}"], cwd=tmp_path, env=user_env,
+                              capture_output=True, text=True, timeout=90)
+        out.wait_for(r"^t=\s*\d+ s sim \| .*\| DEPLOY_STATE WAYPOINTS \|")
+        proc.send_signal(signal.SIGINT)
+        text = out.finish()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        out.finish()
+    assert sent is not None
+    assert sent.returncode == 0, sent.stdout + sent.stderr
+    assert "posted DEPLOY_STATE=WAYPOINTS" in sent.stdout, sent.stdout + sent.stderr
+    assert proc.returncode == 0, text
+    assert "shore schedule: none (no commands: send them with usv-command)" in text
+    # The only command MOOS saw is the user's, and its acknowledgement was recorded by the demo.
+    assert re.search(r"^  1\. t=\d+ s: DEPLOY_STATE=WAYPOINTS$", text, flags=re.M), text
+    assert "  2. t=" not in text and "acknowledgements: 1 posted to MOOS, 0 refused" in text, text
+    assert re.search(r"^waypoints phase t=\d+\.\.\d+ s \(\d+ s, until the end of the run\)", text, flags=re.M), text
+    assert "processes: 8/8 exited cleanly" in text
+    shore_log = (out_dir / "run" / "logs" / "usv.shore.log").read_text()
+    assert "no commands planned" in shore_log and "sent " not in shore_log, shore_log
+    headings = [float(h) for h in re.findall(r"hdg=\s*([-\d.]+)", text)]
+    assert headings and all(0 <= h < 360 for h in headings), headings
