@@ -45,14 +45,16 @@ class Translator(SimpleThread):
         # unique across processes too, so two gateways on one MOOSDB never clash.
         self._name = f"goby::moos::Translator::{threading.get_native_id()}"
         sim = cfg.app.simulation.time
-        if sim.use_sim_time:
-            moos.set_moos_timewarp(float(sim.warp_factor))  # process-global, as Goby's SetMOOSTimeWarp
-        comms = moos.make_comms(comms_kind)
+        # Goby's SetMOOSTimeWarp is process-global; our client gets a clock of its own instead, so translators
+        # of different gateways (or tests) in one process neither share a warp nor overwrite each other's skew.
+        # (The real pymoos has only the process-wide clock: make_comms applies this warp to it.)
+        self._moos_clock = moos.MoosClock(float(sim.warp_factor) if sim.use_sim_time else 1.0)
+        comms = moos.make_comms(comms_kind, clock=self._moos_clock)
         clock = self.context.clock
         self._moos = MOOSInterface(
             comms,
             self.call_soon,
-            moos_time=moos.time,
+            moos_time=moos.moos_time_source(comms),
             goby_time=clock.now,
             technique=cfg.moos.moos_parser_technique,
         )
@@ -67,6 +69,11 @@ class Translator(SimpleThread):
     def moos(self) -> MOOSInterface:
         """The MOOS side: ``add_trigger``, ``add_wildcard_trigger``, ``add_buffer``, ``buffer()``, ``comms()``."""
         return self._moos
+
+    def moos_clock(self) -> moos.MoosClock:
+        """This translator's MOOS clock (the configured warp, and the skew its client learns); use
+        ``moos().moos_time()`` rather than the process-wide ``gateway.moos.time()`` in translator code."""
+        return self._moos_clock
 
     def translator_name(self) -> str:
         """``goby::moos::Translator::<thread id>``: this translator's MOOS client name (unique on the host)."""

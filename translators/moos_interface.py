@@ -67,6 +67,10 @@ class MOOSInterface:
         """The pymoos-compatible client (``notify``, ``notify_binary``, ``register``, ...); thread-safe."""
         return self._comms
 
+    def moos_time(self) -> float:
+        """``MOOSTime`` of this translator's client (its own clock: configured warp plus learned skew)."""
+        return self._moos_time()
+
     def add_trigger(self, var: str, func: MoosCallback) -> None:
         """Call ``func(msg)`` for every ``var`` mail, on the translator's thread.
 

@@ -17,7 +17,7 @@ from .errors import (
     PoisonedError,
     ProtocolError,
 )
-from .factory import make_comms
+from .factory import make_comms, moos_time_source
 from .message import MoosMessage
 
 moos_msg = MoosMessage  # pymoos's name for the message class
@@ -38,7 +38,11 @@ def local_time(apply_timewarping: bool = True, **kwargs: bool) -> float:
 
 
 def set_moos_timewarp(warp: float) -> None:
-    """Set the process-wide time warp used by :func:`time` and by clients built without their own clock."""
+    """Set the process-wide time warp used by :func:`time` and by clients built without their own clock.
+
+    As ``pymoos.set_moos_timewarp``; code that shares a process with others should use its own
+    :class:`MoosClock` (``comms(clock=MoosClock(warp))``) instead.
+    """
     DEFAULT_CLOCK.set_warp(warp)
 
 
@@ -68,6 +72,7 @@ __all__ = [
     "local_time",
     "make_comms",
     "moos_msg",
+    "moos_time_source",
     "pyMOOSException",
     "set_moos_timewarp",
     "time",

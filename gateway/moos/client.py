@@ -41,7 +41,8 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
     """A MOOS client. Method names, signatures and semantics follow pymoos's ``comms``.
 
     ``comms()`` is asynchronous like pymoos; ``comms(asynchronous=False)`` speaks the synchronous protocol;
-    ``clock=`` gives it its own :class:`MoosClock` (default: the process-wide one, as in libMOOS).
+    ``clock=`` gives it its own :class:`MoosClock` (warp, and the skew learned from the DB); without it the client
+    shares the process-wide ``DEFAULT_CLOCK`` with ``gateway.moos.time()``, as libMOOS clients do.
     """
 
     # ---- lifecycle ---------------------------------------------------------------------------------

@@ -1,9 +1,11 @@
 """MOOS time: warped unix time plus a skew, as ``MOOSLocalTime`` / ``MOOSTime``.
 
 Warp multiplies *absolute* unix time (at warp 10 timestamps are about 1.8e10). libMOOS keeps warp and skew
-process-global; here they live in a :class:`MoosClock` object, and the module functions of
-``gateway.moos`` (``time``, ``local_time``, ``set_moos_timewarp``) use one shared default clock so that pymoos
-scripts behave as before. Tests and embedders may pass their own clock instead.
+process-global; here they live in a :class:`MoosClock` object. The module functions of ``gateway.moos``
+(``time``, ``local_time``, ``set_moos_timewarp``) and every client built without a clock share
+:data:`DEFAULT_CLOCK`, so pymoos scripts behave as with pymoos (one warp, one skew per process). Anything that
+may share a process with other MOOS users -- translators, tools, tests -- should give its client its own clock
+(``comms(clock=...)``, ``make_comms(..., clock=...)``): then its warp and the skew its client learns stay its own.
 """
 
 from __future__ import annotations
@@ -56,3 +58,5 @@ class MoosClock:
 
 
 DEFAULT_CLOCK = MoosClock()
+"""The process-wide clock of pymoos-style code: ``gateway.moos.time()``/``set_moos_timewarp()`` and clients
+built without ``clock=`` (each of them writes the skew it learns here, as libMOOS clients do)."""

@@ -44,7 +44,7 @@ class ClientEngine:
 
     def __init__(self, asynchronous: bool = True, clock: MoosClock | None = None) -> None:
         self._async = asynchronous
-        self._clock = clock or DEFAULT_CLOCK
+        self._clock = clock if clock is not None else DEFAULT_CLOCK
         self._lock = threading.Lock()
         self._cond = threading.Condition(self._lock)
         self._outbox: list[bytes] = []  # encoded messages, in post order
@@ -94,6 +94,11 @@ class ClientEngine:
         self._bytes_read_total = 0
         self._fatal: MoosError | None = None
         self.welcome: Welcome | None = None  # the DB's last WELCOME (community, skew, DB time, hostname)
+
+    @property
+    def clock(self) -> MoosClock:
+        """The :class:`MoosClock` this client stamps messages with and writes its skew into."""
+        return self._clock
 
     def _reregister(self) -> None:
         """Send the remembered registrations again (the API layer fills this in)."""

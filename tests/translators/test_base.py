@@ -6,6 +6,7 @@ from __future__ import annotations
 import queue
 import re
 import threading
+import time
 from typing import Any
 
 import pytest
@@ -255,3 +256,39 @@ def test_asking_for_the_real_pymoos_when_missing_is_a_clear_error(infrastructure
     with pytest.raises(PluginLoadError, match="the real pymoos was requested but cannot be imported"):
         with hosted_translators(gateway_config(db.port, broker.interprocess_config()), PymoosTranslator):
             pass
+
+
+def _time_posts(client, count: int = 2) -> list[float]:
+    posts = collect_mail(client, [TIME_VAR], until=count, timeout=20)
+    assert len(posts) >= count, [p.string() for p in posts]
+    return [float(re.match(r"moostime=([0-9.e+]+),", p.string()).group(1)) for p in posts]
+
+
+def test_translators_with_different_warps_keep_their_own_moos_clocks(tmp_path):
+    """Two gateways in one process, each with its own MOOSDB: one on warp 10 (``use_sim_time``), one unwarped.
+    Each translator's MOOS time follows its own configuration; neither touches the process-wide MOOS clock."""
+    from gateway.moos.clock import DEFAULT_CLOCK
+
+    before = (DEFAULT_CLOCK.warp, DEFAULT_CLOCK.skew)
+    with running_moosdb(warp=10) as fast_db, running_moosdb() as plain_db, \
+            broker_process(tmp_path, platform="tclock") as broker:
+        fast_cfg = gateway_config(fast_db.port, broker.interprocess_config(), app_name="fast_gateway")
+        fast_cfg.app.simulation.time.use_sim_time = True
+        fast_cfg.app.simulation.time.warp_factor = 10
+        plain_cfg = gateway_config(plain_db.port, broker.interprocess_config(), app_name="plain_gateway")
+        with connected_comms(fast_db.port, "fast_watcher", register=[TIME_VAR]) as fast_watcher, \
+                connected_comms(plain_db.port, "plain_watcher", register=[TIME_VAR]) as plain_watcher, \
+                hosted_translators(fast_cfg, Translator) as fast_gw, \
+                hosted_translators(plain_cfg, Translator) as plain_gw:
+            fast_times, plain_times = _time_posts(fast_watcher), _time_posts(plain_watcher)
+            (fast,), (plain,) = fast_gw.threads(), plain_gw.threads()
+            assert fast.moos_clock() is not plain.moos_clock()
+            assert (fast.moos_clock().warp, plain.moos_clock().warp) == (10.0, 1.0)
+            assert (DEFAULT_CLOCK.warp, DEFAULT_CLOCK.skew) == before
+            now = time.time()
+            assert fast.moos().moos_time() / now == pytest.approx(10.0, rel=1e-3)
+            assert plain.moos().moos_time() == pytest.approx(now, abs=5.0)
+    for moos_time in fast_times:
+        assert moos_time / now == pytest.approx(10.0, rel=1e-3)
+    for moos_time in plain_times:
+        assert moos_time == pytest.approx(now, abs=30.0)
