@@ -7,12 +7,11 @@ kinematic vehicle (turn rate 30 deg/s, acceleration 0.5 m/s^2), so the figures a
 from __future__ import annotations
 
 import math
-import tempfile
 import time
 from pathlib import Path
 
-from behaviors.helm.config import HelmConfig
 from behaviors.helm.helm import Helm
+from behaviors.helm.testing import helm_from_text
 
 REPO = Path(__file__).resolve().parents[1]
 SURVEY = """\
@@ -42,11 +41,8 @@ class Vehicle:
 
 
 def make_helm(bhv_text: str, speed_max: str = "4") -> Helm:
-    path = Path(tempfile.mkdtemp()) / "bench.bhv"
-    path.write_text(bhv_text)
-    cfg = HelmConfig.from_pairs([("behaviors", str(path)), ("domain", "course:0:359:360"),
-                                 ("domain", f"speed:0:{speed_max}:41"), ("start_engaged", "true")], "bench")
-    return Helm(cfg, ownship="bench")
+    return helm_from_text(bhv_text, ("course:0:359:360", f"speed:0:{speed_max}:41"), ownship="bench",
+                          where="bench", start_engaged="true")
 
 
 def run(helm: Helm, vehicle: Vehicle, seconds: float, pokes: dict[str, str] | None = None) -> float:

@@ -8,6 +8,7 @@ The per-iteration state machine that calls these hooks lives in :mod:`behaviors.
 from __future__ import annotations
 
 import logging
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 from .errors import ParamError, UnknownParamError
@@ -57,8 +58,9 @@ class Posting:
     key: str = ""
 
 
-class Behavior:
-    """Common behaviour state. Subclasses set ``TYPE``, ``DEFAULT_NAME`` and ``DOMAIN_VARS``."""
+class Behavior(ABC):
+    """Common behaviour state. Subclasses set ``TYPE``, ``DEFAULT_NAME`` and ``DOMAIN_VARS``, and implement
+    :meth:`set_specific_param` and :meth:`on_run_state`; the other ``on_*`` hooks are optional."""
 
     TYPE = "BHV_Base"
     DEFAULT_NAME = "bhv_base"
@@ -104,9 +106,9 @@ class Behavior:
             raise ParamError(_NOT_SUPPORTED[param])
         raise UnknownParamError(f"unknown parameter '{param}' for {self.TYPE}")
 
+    @abstractmethod
     def set_specific_param(self, param: str, value: str) -> bool:
         """Behaviour-specific parameters; return False if ``param`` is not one of them."""
-        return False
 
     def _set_common_param(self, param: str, value: str) -> bool:
         flag_kind = param.replace("_flag", "flag")
@@ -154,7 +156,7 @@ class Behavior:
             return False
         return True
 
-    def on_set_param_complete(self) -> None:
+    def on_set_param_complete(self) -> None:  # noqa: B027 (optional hook)
         """Called after configuration and after each successful update."""
 
     def check_config(self) -> None:
@@ -300,20 +302,21 @@ class Behavior:
             self.set_complete()
 
     # ---- hooks ---------------------------------------------------------------------------------
+    @abstractmethod
     def on_run_state(self) -> ObjectiveFunction | None:
-        return None
+        """The objective function for this iteration (None: no opinion); may :meth:`post`."""
 
-    def on_idle_state(self) -> None:
+    def on_idle_state(self) -> None:  # noqa: B027 (optional hook: doing nothing is the default)
         pass
 
-    def on_idle_to_run_state(self) -> None:
+    def on_idle_to_run_state(self) -> None:  # noqa: B027 (optional hook: doing nothing is the default)
         pass
 
-    def on_run_to_idle_state(self) -> None:
+    def on_run_to_idle_state(self) -> None:  # noqa: B027 (optional hook: doing nothing is the default)
         pass
 
-    def on_inactive_state(self) -> None:
+    def on_inactive_state(self) -> None:  # noqa: B027 (optional hook: doing nothing is the default)
         pass
 
-    def on_complete_state(self) -> None:
+    def on_complete_state(self) -> None:  # noqa: B027 (optional hook: doing nothing is the default)
         pass

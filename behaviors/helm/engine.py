@@ -55,7 +55,7 @@ class HelmEngine:
         modes = self.modes.evaluate(self.info) if self.modes else {}
         for var, value in modes.items():
             typed: Value = float(value) if is_number(value) else value
-            self.info.set(var, typed, now)
+            self.info.set(var, typed)
             if self._posted_modes.get(var) != value:
                 self._posted_modes[var] = value
                 extra.append(Posting(var, typed, key="mode_set"))
@@ -152,7 +152,7 @@ class HelmEngine:
         """Write every posting into the info buffer; pass repeatable ones and changed values on."""
         passed = []
         for posting in outbox:
-            self.info.set(posting.var, posting.value, now)
+            self.info.set(posting.var, posting.value)
             key = f"{bhv.name}|{posting.var}|{posting.key}"
             if posting.repeatable or self._last_posted.get(key) != posting.value:
                 self._last_posted[key] = posting.value

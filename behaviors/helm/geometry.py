@@ -21,11 +21,6 @@ def angle180(a: float) -> float:
     return a - 360.0 if a > 180.0 else a
 
 
-def angle_diff(a: float, b: float) -> float:
-    """Unsigned difference of two compass angles, in [0, 180]."""
-    return abs(angle180(a - b))
-
-
 def segment_angle(x1: float, y1: float, x2: float, y2: float, x3: float, y3: float) -> float:
     """Turn (degrees, clockwise positive) at (x2,y2) going from the leg 1→2 to the leg 2→3."""
     if (x1, y1) == (x2, y2) or (x2, y2) == (x3, y3):

@@ -95,7 +95,7 @@ class Helm:
         for init in self.initializes:
             if not init.deferred:
                 out.append(Post(init.var, init.value, "HELM_VAR_INIT"))
-                self.info.set(init.var, init.value, now)
+                self.info.set(init.var, init.value)
         for kind in ("ACTIVE", "RUNNING", "IDLE", "DISABLED"):
             out.append(Post(f"IVPHELM_BHV_{kind}_CNT", 0.0))
         for bhv in self.engine.behaviors:
@@ -126,7 +126,7 @@ class Helm:
                 self.state = "DISABLED"
         elif var == "HELM_MAP_CLEAR":
             self.engine.clear_post_filter()
-        self.info.set(var, value, msg_time)
+        self.info.set(var, value)
         return out
 
     def iterate(self, now: float) -> list[Post]:
@@ -183,7 +183,7 @@ class Helm:
         for init in self.initializes:
             if init.deferred and not self.info.is_known(init.var):
                 out.append(Post(init.var, init.value, "HELM_VAR_INIT"))
-                self.info.set(init.var, init.value, now)
+                self.info.set(init.var, init.value)
         return out
 
     def _all_stop(self, message: str) -> list[Post]:

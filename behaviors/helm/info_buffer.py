@@ -8,21 +8,19 @@ Value = float | str
 
 
 class InfoBuffer:
-    """Last value, its time, and the per-iteration list of new values (``updates`` needs every post)."""
+    """Last value and the per-iteration list of new values (``updates`` needs every post)."""
 
     def __init__(self) -> None:
         self._values: dict[str, Value] = {}
-        self._times: dict[str, float] = {}
         self._deltas: dict[str, list[Value]] = defaultdict(list)
 
-    def set(self, var: str, value: Value, time: float) -> None:
+    def set(self, var: str, value: Value) -> None:
         """Record a new value; strings and floats keep their MOOS type."""
         if isinstance(value, bool):
             value = "true" if value else "false"
         if isinstance(value, int):
             value = float(value)
         self._values[var] = value
-        self._times[var] = time
         self._deltas[var].append(value)
 
     def get(self, var: str) -> Value | None:
@@ -34,9 +32,6 @@ class InfoBuffer:
 
     def is_known(self, var: str) -> bool:
         return var in self._values
-
-    def time_of(self, var: str) -> float | None:
-        return self._times.get(var)
 
     def deltas(self, var: str) -> list[Value]:
         """Values posted to ``var`` since the last :meth:`clear_deltas`, oldest first."""

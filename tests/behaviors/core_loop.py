@@ -8,19 +8,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from behaviors.helm.config import HelmConfig
 from behaviors.helm.helm import Helm, Post
+from behaviors.helm.testing import DOMAIN, helm_from_text
 
 from .kinematic_vehicle import KinematicModel
 
-DOMAIN = ("course:0:359:360", "speed:0:4:41")
-
 
 def make_helm(tmp_path: Path, bhv_text: str, domains=DOMAIN, **params: str) -> Helm:
-    path = tmp_path / "test.bhv"
-    path.write_text(bhv_text)
-    pairs = [("behaviors", str(path))] + [("domain", d) for d in domains] + list(params.items())
-    return Helm(HelmConfig.from_pairs(pairs, "test.moos: ProcessConfig = pHelmIvP"), ownship="alpha")
+    """A helm for ``bhv_text``; the file stays in ``tmp_path`` for a failing test to show."""
+    return helm_from_text(bhv_text, domains, directory=tmp_path, **params)
 
 
 class CoreLoop:
