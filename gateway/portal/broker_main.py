@@ -16,8 +16,7 @@ import threading
 
 from gateway.logsetup import configure_logging
 from gateway.portal.broker import Broker, BrokerError
-from gateway.portal.config import debug_text, example_config, load_config
-from gateway.portal.errors import ConfigError
+from gateway.portal.config import load_for_run
 from gateway.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
 
 log = logging.getLogger(__name__)
@@ -26,18 +25,10 @@ READY_PREFIX = "goby-broker ready: "
 
 
 def main(argv: list[str] | None = None) -> int:
-    try:
-        loaded = load_config(GobyDaemonConfig, argv, prog="goby-broker")
-    except ConfigError as exc:
-        print(f"goby-broker: configuration error: {exc}", file=sys.stderr)
-        return 2
-    if loaded.example_requested:
-        print(example_config(GobyDaemonConfig))
-        return 0
+    loaded = load_for_run(GobyDaemonConfig, argv, "goby-broker")
+    if isinstance(loaded, int):
+        return loaded
     cfg = loaded.cfg
-    if loaded.debug_cfg:
-        print(debug_text(cfg), end="")
-        return 0
     configure_logging(loaded.verbosity, cfg.app.name)
     if not cfg.interprocess.HasField("platform"):
         log.warning("Using default platform name of %s", cfg.interprocess.platform)

@@ -219,3 +219,23 @@ def _comment_out(field: pb_descriptor.FieldDescriptor) -> bool:
 def debug_text(cfg: pb_message.Message) -> str:
     """The parsed configuration as text format (what ``app { debug_cfg: true }`` prints)."""
     return text_format.MessageToString(cfg)
+
+
+def load_for_run(config_type: type[pb_message.Message], argv: list[str] | None, prog: str) -> LoadedConfig | int:
+    """The start-up every Goby-style program shares: parse, or handle ``--example_config``/``debug_cfg``.
+
+    Returns the loaded configuration to run with, or the exit code to return at once: 0 after printing the
+    example or the parsed configuration, 2 after printing a configuration error naming the cause.
+    """
+    try:
+        loaded = load_config(config_type, argv, prog)
+    except ConfigError as exc:
+        print(f"{prog}: configuration error: {exc}", file=sys.stderr)
+        return 2
+    if loaded.example_requested:
+        print(example_config(config_type))
+        return 0
+    if loaded.debug_cfg:
+        print(debug_text(loaded.cfg), end="")
+        return 0
+    return loaded

@@ -13,9 +13,9 @@ from typing import Any
 from google.protobuf import message as pb_message
 
 from gateway.logsetup import configure_logging
-from gateway.portal.config import debug_text, example_config, load_config
+from gateway.portal.config import load_for_run
 from gateway.portal.context import ProcessContext, use_context
-from gateway.portal.errors import BrokerUnavailableError, ConfigError
+from gateway.portal.errors import BrokerUnavailableError
 from gateway.portal.interface_registry import process_registry
 from gateway.portal.thread import SimpleThread, interprocess_config_of
 from gateway.portal.timeutil import SystemClock
@@ -49,18 +49,10 @@ def run_application(
     does not answer or the application fails; 2 for a bad configuration.
     """
     prog = prog or os.path.basename(sys.argv[0] or "app")
-    try:
-        loaded = load_config(config_type, argv, prog)
-    except ConfigError as exc:
-        print(f"{prog}: configuration error: {exc}", file=sys.stderr)
-        return 2
-    if loaded.example_requested:
-        print(example_config(config_type))
-        return 0
+    loaded = load_for_run(config_type, argv, prog)
+    if isinstance(loaded, int):
+        return loaded
     cfg = loaded.cfg
-    if loaded.debug_cfg:
-        print(debug_text(cfg), end="")
-        return 0
     app_name = cfg.app.name if "app" in cfg.DESCRIPTOR.fields_by_name else prog
     configure_logging(loaded.verbosity, app_name)
     apply_simulation_time(cfg)
