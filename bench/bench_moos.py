@@ -13,7 +13,6 @@ import argparse
 import contextlib
 import json
 import os
-import socket
 import statistics
 import subprocess
 import sys
@@ -25,7 +24,7 @@ from pathlib import Path
 
 from bench.stats import median_p99
 from gateway.moos.factory import make_comms, pymoos_available
-from gateway.moos.testing import free_port, real_moos_skip_reason
+from gateway.moos.testing import real_moos_skip_reason, real_moosdb, stop_process
 
 HERE = Path(__file__).resolve().parents[1]
 
@@ -205,25 +204,13 @@ def start_db(kind: str) -> Iterator[tuple[int, int]]:
                                 text=True, cwd=HERE)
         line = proc.stdout.readline()  # type: ignore[union-attr]
         port = int(line.rsplit(":", 1)[1])
-    else:
-        port = free_port()
-        proc = subprocess.Popen(["MOOSDB", f"--moos_port={port}", "--moos_community=bench", "--moos_suicide_disable"],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, text=True)
-        deadline = time.monotonic() + 10
-        while time.monotonic() < deadline:
-            with socket.socket() as s:
-                if s.connect_ex(("127.0.0.1", port)) == 0:
-                    break
-            time.sleep(0.05)
-    try:
-        yield port, proc.pid
-    finally:
-        proc.terminate()
         try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+            yield port, proc.pid
+        finally:
+            stop_process(proc, 10)
+        return
+    with tempfile.TemporaryDirectory() as workdir, real_moosdb(workdir, community="bench") as (port, proc):
+        yield port, proc.pid
 
 
 def process_stats(pid: int) -> tuple[float, float]:

@@ -60,6 +60,41 @@ def real_moos_skip_reason(*binaries: str) -> str | None:
     return None
 
 
+def stop_process(proc: subprocess.Popen, timeout: float = 5.0) -> int | None:
+    """SIGTERM ``proc``, then SIGKILL if it has not ended within ``timeout``; returns its exit status."""
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            return proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+    return proc.wait(timeout)
+
+
+@contextlib.contextmanager
+def real_moosdb(workdir: str | os.PathLike[str], port: int | None = None, community: str = "moos",
+                warp: float = 1.0) -> Iterator[tuple[int, subprocess.Popen]]:
+    """The C++ MOOSDB as a child process, listening before this yields ``(port, process)``; stopped on exit.
+
+    Check ``real_moos_skip_reason()`` first: the C++ MOOSDB listens on every address, so only run it inside a
+    private network namespace. Its output goes to ``workdir/MOOSDB-<port>.log``.
+    """
+    port = port or free_port()
+    log_path = Path(workdir) / f"MOOSDB-{port}.log"
+    with open(log_path, "wb") as log:
+        proc = subprocess.Popen(
+            ["MOOSDB", f"--moos_port={port}", f"--moos_community={community}", f"--moos_time_warp={warp}",
+             "--moos_suicide_disable"],
+            stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, cwd=workdir,
+        )
+        try:
+            if not wait_for(lambda: port_open(port) or proc.poll() is not None, 10) or proc.poll() is not None:
+                raise RuntimeError(f"MOOSDB did not start on port {port}: {log_path.read_text()}")
+            yield port, proc
+        finally:
+            stop_process(proc)
+
+
 def wait_for(predicate: Callable[[], Any], timeout: float = 10.0, interval: float = 0.01) -> Any:
     """Poll ``predicate`` until it returns something truthy (returned) or ``timeout`` passes (returns it falsy)."""
     deadline = time.monotonic() + timeout

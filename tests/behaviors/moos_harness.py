@@ -15,6 +15,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from gateway.moos import MoosClock, comms
+from gateway.moos.testing import stop_process
 
 from .kinematic_vehicle import KinematicModel, KinematicVehicle
 
@@ -108,12 +109,7 @@ def helm_process(mission: Path, tmp_path: Path, command: list[str] | None = None
     try:
         yield proc
     finally:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(10)
+        stop_process(proc, 10)
         log.close()
 
 

@@ -10,16 +10,13 @@ Both runs use the real MOOSDB; only the helm differs. Tolerances are stated next
 
 from __future__ import annotations
 
-import contextlib
 import math
-import subprocess
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 from gateway.moos import MoosClock
-from gateway.moos.testing import free_port, real_moos_skip_reason
+from gateway.moos.testing import free_port, real_moos_skip_reason, real_moosdb
 
 from .moos_harness import REPO, WARP, helm_process, observer, ring_stats, vehicle, write_mission
 from .test_closed_loop import SURVEY, WATCH
@@ -33,23 +30,6 @@ pytestmark = [
 HELMS = {"pHelmIvP": lambda mission: ["pHelmIvP", str(mission)], "ivp-helm": None}
 
 
-@contextlib.contextmanager
-def real_moosdb(tmp_path: Path, port: int) -> Iterator[subprocess.Popen]:
-    log = open(tmp_path / "moosdb.log", "wb")
-    proc = subprocess.Popen(["MOOSDB", f"--moos_port={port}", f"--moos_time_warp={WARP}", "--moos_community=alpha"],
-                            stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, cwd=tmp_path)
-    try:
-        yield proc
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(10)
-        log.close()
-
-
 def run_survey(tmp_path: Path, helm: str) -> dict[str, object]:
     """Waypoint mission: returns the WPT_INDEX order and the MOOS time (since DRIVE) of each arrival."""
     work = tmp_path / helm
@@ -59,7 +39,7 @@ def run_survey(tmp_path: Path, helm: str) -> dict[str, object]:
     port = free_port()
     clock = MoosClock(WARP)
     mission = write_mission(work, port, bhv)
-    with real_moosdb(work, port), observer(port, clock, WATCH + ["DEPLOY"]) as obs, \
+    with real_moosdb(work, port, community="alpha", warp=WARP), observer(port, clock, WATCH + ["DEPLOY"]) as obs, \
             helm_process(mission, work, HELMS[helm](mission) if HELMS[helm] else None), \
             vehicle(port, clock, x=0, y=0, heading=0):
         assert obs.wait(lambda: obs.last("IVPHELM_STATE") == "PARK", timeout=30), helm
@@ -80,7 +60,7 @@ def run_loiter(tmp_path: Path, helm: str) -> dict[str, float]:
     port = free_port()
     clock = MoosClock(WARP)
     mission = write_mission(work, port, REPO / "behaviors" / "usv.bhv", community="trail_usv")
-    with real_moosdb(work, port), observer(port, clock, WATCH) as obs, \
+    with real_moosdb(work, port, community="alpha", warp=WARP), observer(port, clock, WATCH) as obs, \
             helm_process(mission, work, HELMS[helm](mission) if HELMS[helm] else None), \
             vehicle(port, clock, x=0, y=-120, heading=0) as sim:
         assert obs.wait(lambda: obs.last("IVPHELM_STATE") == "DRIVE", timeout=30), helm

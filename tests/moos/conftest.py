@@ -6,8 +6,6 @@ whose only interface is loopback), e.g. under ``/opt/moos/bin/netns-run``.
 
 from __future__ import annotations
 
-import contextlib
-import subprocess
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -15,35 +13,11 @@ import pytest
 
 from gateway.moos.clock import DEFAULT_CLOCK
 from gateway.moos.server import MoosDB
-from gateway.moos.testing import free_port, port_open, real_moos_skip_reason, wait_for
+from gateway.moos.testing import real_moos_skip_reason, real_moosdb
 
 
 def real_moosdb_skip_reason() -> str | None:
     return real_moos_skip_reason("MOOSDB")
-
-
-@contextlib.contextmanager
-def real_moosdb(tmp_path: Path, community: str = "moos", warp: float = 1.0) -> Iterator[int]:
-    """The C++ MOOSDB as a child process on a free port; yields the port."""
-    port = free_port()
-    log = open(tmp_path / f"MOOSDB-{port}.log", "wb")
-    proc = subprocess.Popen(
-        ["MOOSDB", f"--moos_port={port}", f"--moos_community={community}", f"--moos_time_warp={warp}",
-         "--moos_suicide_disable"],
-        stdout=log, stderr=subprocess.STDOUT, cwd=tmp_path,
-    )
-    try:
-        if not wait_for(lambda: port_open(port) or proc.poll() is not None, 10) or proc.poll() is not None:
-            raise RuntimeError(f"MOOSDB did not start: {(tmp_path / f'MOOSDB-{port}.log').read_text()}")
-        yield port
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(5)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(5)
-        log.close()
 
 
 @pytest.fixture
@@ -62,7 +36,7 @@ def db_port(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[int]:
         reason = real_moosdb_skip_reason()
         if reason:
             pytest.skip(reason)
-        with real_moosdb(tmp_path) as port:
+        with real_moosdb(tmp_path) as (port, _):
             yield port
 
 

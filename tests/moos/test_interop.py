@@ -19,7 +19,7 @@ import pytest
 from gateway.moos import make_comms
 from gateway.moos.errors import MoosError
 from gateway.moos.factory import pymoos_available
-from gateway.moos.testing import collect_mail, connected_comms
+from gateway.moos.testing import collect_mail, connected_comms, stop_process
 
 pytestmark = pytest.mark.interop
 SCRIPT = Path(__file__).with_name("pymoos_script.py")
@@ -112,12 +112,7 @@ def test_uxms_scopes_our_db(db_port: int, tmp_path: Path) -> None:
                     poster.notify("KEEP_BUSY", 1.0)  # the C++ DB pushes held mail after notifications
                     time.sleep(0.1)
             finally:
-                proc.terminate()
-                try:
-                    proc.wait(5)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
-                    proc.wait(5)
+                stop_process(proc)
         text = out.read_bytes().decode(errors="replace")
         assert "visible-value" in text and "poster" in text
 
@@ -140,12 +135,7 @@ def test_a_real_moos_app_runs_against_our_db(tmp_path: Path) -> None:
         try:
             got = {m.key(): m for m in collect_mail(w, ["TS_HELLO", "TS_NUM"], timeout=20)}
         finally:
-            proc.terminate()
-            try:
-                proc.wait(5)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait(5)
+            stop_process(proc)
         assert got["TS_HELLO"].string() == "world" and got["TS_HELLO"].source() == "uTimerScript"
         assert got["TS_NUM"].is_double() and got["TS_NUM"].double() == 42.0
         assert got["TS_NUM"].community() == "tsx"
