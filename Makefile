@@ -24,7 +24,7 @@ bench: $(VENV)/.installed
 	$(BIN)/python -m bench
 
 protos: $(VENV)/.installed
-	$(BIN)/python -m gateway.protobuf.generate
+	$(BIN)/python -m tools.generate_protos
 
 interfaces: $(VENV)/.installed
 	$(BIN)/goby-interfaces generate --all

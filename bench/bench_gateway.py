@@ -23,9 +23,9 @@ from collections.abc import Callable
 from pathlib import Path
 
 from bench.stats import percentile
+from gateway.goby.portal.testing import PortalClient, broker_process
 from gateway.moos.client import comms
 from gateway.moos.testing import moosdb_process
-from gateway.portal.testing import PortalClient, broker_process
 from translators.testing import GatewayProcess
 
 PLUGIN = '''

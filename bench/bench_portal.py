@@ -19,9 +19,9 @@ from pathlib import Path
 from google.protobuf import text_format
 
 from bench.stats import median_p99
-from gateway.portal.protobuf.test_messages_pb2 import Sample, Widget
-from gateway.portal.testing import AppProcess, BrokerProcess, PortalClient
-from gateway.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from gateway.goby.portal.testing import AppProcess, BrokerProcess, PortalClient
+from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from tests.protobuf.sample_messages_pb2 import Sample, Widget
 
 WINDOW = 500  # in flight; below the default send/receive queue sizes (1000)
 PROGRESS_EVERY = 100
@@ -125,9 +125,9 @@ def call_soon_latency(n: int) -> tuple[float, float]:
     """call_soon from this thread to a SimpleThread blocked in its poll: (median, p99) µs until fn runs there."""
     import threading
 
-    from gateway.portal import MultiThreadApplication, SimpleThread
-    from gateway.portal.testing import running_app
-    from gateway.protobuf.app_config_pb2 import AppConfig
+    from gateway.goby.portal import MultiThreadApplication, SimpleThread
+    from gateway.goby.portal.testing import running_app
+    from gateway.goby.protobuf.app_config_pb2 import AppConfig
 
     class Idle(SimpleThread):
         pass
@@ -149,7 +149,7 @@ def call_soon_latency(n: int) -> tuple[float, float]:
 
 def in_process_costs(client: PortalClient, n: int) -> tuple[float, float]:
     """(publish µs, receive-dispatch µs) per small message, measured in this process without the network."""
-    from gateway.portal.identifier import encode_frame, make_identifier
+    from gateway.goby.portal.identifier import encode_frame, make_identifier
 
     received: list[Sample] = []
     client.subscribe("bench_local", Sample, received.append)

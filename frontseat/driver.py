@@ -25,8 +25,8 @@ from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_pb2 as fs_pb
 from frontseat.signals import Signal
-from gateway.geodesy import UTMGeodesy
-from gateway.protobuf import geographic_pb2 as geo_pb
+from gateway.goby.protobuf import geographic_pb2 as geo_pb
+from util.geodesy import UTMGeodesy
 
 log = logging.getLogger(__name__)
 raw_in_log = logging.getLogger("frontseat.raw.in")
@@ -40,7 +40,7 @@ class Clock(Protocol):
 
 
 def _process_clock() -> Clock:
-    from gateway.portal import clock  # imported late: pure state-machine users need no portal
+    from gateway.goby.portal import clock  # imported late: pure state-machine users need no portal
 
     return clock
 

@@ -6,7 +6,7 @@ here once and everyone (interface, translators, helm, tests) imports them.
 
 from __future__ import annotations
 
-from gateway.portal import Group
+from gateway.goby.portal import Group
 
 _PREFIX = "goby::middleware::frontseat::"
 

@@ -27,8 +27,8 @@ from frontseat.protobuf import frontseat_interface_config_pb2 as app_pb
 from frontseat.protobuf import frontseat_pb2 as fs_pb
 from frontseat.protobuf import moos_helm_frontseat_interface_config_pb2 as helm_pb
 from frontseat.protobuf import navigation_pb2 as nav_pb
-from gateway.portal import MultiThreadApplication, run_application
-from gateway.protobuf import moos_gateway_config_pb2 as gateway_pb
+from gateway.goby.portal import MultiThreadApplication, run_application
+from gateway.moos_gateway.protobuf import moos_gateway_config_pb2 as gateway_pb
 
 log = logging.getLogger(__name__)
 
@@ -119,11 +119,11 @@ class FrontSeatInterface(MultiThreadApplication):
         log.info("launching the MOOS helm interface thread (MOOSDB %s:%d)", gateway_cfg.moos.server,
                  gateway_cfg.moos.port)
         try:
-            from translators.frontseat_translation import FrontSeatTranslation
+            from translators.frontseat.translation import FrontSeatTranslation
         except ImportError as exc:
             raise FrontSeatException(
                 f"the config has a [goby.moos.protobuf.moos_helm] block but the MOOS helm interface "
-                f"(translators.frontseat_translation.FrontSeatTranslation) cannot be imported: {exc}"
+                f"(translators.frontseat.translation.FrontSeatTranslation) cannot be imported: {exc}"
             ) from exc
         self.launch_thread(FrontSeatTranslation, gateway_cfg)
 
@@ -214,7 +214,7 @@ class FrontSeatInterface(MultiThreadApplication):
 
 def example_config(driver_module: object | None = None) -> str:
     """A commented example configuration, with the driver's extension block when it declares one."""
-    from gateway.portal.config import example_config as message_example
+    from gateway.goby.portal.config import example_config as message_example
 
     fields = app_pb.FrontSeatInterfaceConfig.DESCRIPTOR.fields_by_name
     app_body = message_example(fields["app"].message_type, 1)

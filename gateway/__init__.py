@@ -1,1 +1,2 @@
-"""MOOS side (``gateway.moos``), Goby side (``gateway.portal``) and the gateway process that joins them."""
+"""MOOS side (``gateway.moos``), Goby side (``gateway.goby``) and the gateway process that joins them
+(``gateway.moos_gateway``)."""

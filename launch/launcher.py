@@ -19,10 +19,10 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from gateway.logsetup import add_verbosity_argument, configure_logging
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import parse_file
 from launch.process_group import ProcessGroup
+from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from gateway.geodesy import UTMGeodesy, utm_zone
+from util.geodesy import UTMGeodesy, utm_zone
 
 FOREST_LAKE = (43.8253, -70.3304)
 # (x, y) -> (lat, lon), computed independently with pyproj/PROJ and a port of MOOS's Gantz code.

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from gateway.protobuf.generate import REPO_ROOT, generate
+from tools.generate_protos import REPO_ROOT, generate
 
 
 def test_generated_protobuf_code_is_up_to_date() -> None:
     stale = generate(check=True)
-    assert not stale, "regenerate with `python -m gateway.protobuf.generate`: " + ", ".join(
+    assert not stale, "regenerate with `python -m tools.generate_protos`: " + ", ".join(
         str(p.relative_to(REPO_ROOT)) for p in stale
     )

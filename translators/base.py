@@ -16,8 +16,8 @@ import logging
 import threading
 
 import gateway.moos as moos
-from gateway.portal import SimpleThread
-from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from gateway.goby.portal import SimpleThread
+from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from translators.moos_interface import TIME_VAR, MOOSInterface
 
 log = logging.getLogger(__name__)

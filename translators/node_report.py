@@ -12,11 +12,11 @@ import logging
 
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
-from gateway.portal import MultiThreadApplication
-from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from gateway.goby.portal import MultiThreadApplication
+from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from translators.base import Translator
-from translators.frontseat_translation import geodesy_from_config
-from translators.nav_conversion import node_report
+from translators.frontseat.nav_conversion import node_report
+from translators.frontseat.translation import geodesy_from_config
 
 log = logging.getLogger(__name__)
 

@@ -1,5 +1,5 @@
 """Test helpers for translators: host translator classes in-process as the gateway does, or run ``moos-gateway``
-as a process with plugins.  Pair them with ``gateway.moos.testing`` (a MOOSDB) and ``gateway.portal.testing``
+as a process with plugins.  Pair them with ``gateway.moos.testing`` (a MOOSDB) and ``gateway.goby.portal.testing``
 (a broker and a portal client)::
 
     with running_moosdb() as db, broker_process(tmp_path) as broker:
@@ -19,11 +19,11 @@ import threading
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
-from gateway.moos_gateway import GobyMOOSGateway
-from gateway.plugins import ENV_VAR, Plugin
-from gateway.portal import ProcessContext, SimpleThread, use_context
-from gateway.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
-from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from gateway.goby.portal import ProcessContext, SimpleThread, use_context
+from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from gateway.moos_gateway.app import GobyMOOSGateway
+from gateway.moos_gateway.plugins import ENV_VAR, Plugin
+from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 
 
 def gateway_config(moos_port: int, interprocess: InterProcessPortalConfig | None = None,
@@ -90,7 +90,7 @@ class GatewayProcess:
         self.stderr_path = self.workdir / "gateway.err"
 
     def start(self) -> GatewayProcess:
-        cmd = [sys.executable, "-m", "gateway.moos_gateway", str(self.config_path), *self.extra_args]
+        cmd = [sys.executable, "-m", "gateway.moos_gateway.app", str(self.config_path), *self.extra_args]
         with open(self.stdout_path, "ab") as out, open(self.stderr_path, "ab") as err:
             self.proc = subprocess.Popen(cmd, stdout=out, stderr=err, env=self.env, cwd=self.workdir)
         return self

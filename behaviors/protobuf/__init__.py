@@ -1,1 +1,1 @@
-"""Config protos of the behaviours package (generated code is committed; see gateway.protobuf.generate)."""
+"""Config protos of the behaviours package (generated code is committed; see tools.generate_protos)."""

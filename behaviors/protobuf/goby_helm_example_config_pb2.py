@@ -22,17 +22,17 @@ _runtime_version.ValidateProtobufRuntimeVersion(
 _sym_db = _symbol_database.Default()
 
 
-from gateway.protobuf import app_config_pb2 as gateway_dot_protobuf_dot_app__config__pb2
-from gateway.protobuf import interprocess_config_pb2 as gateway_dot_protobuf_dot_interprocess__config__pb2
+from gateway.goby.protobuf import app_config_pb2 as gateway_dot_goby_dot_protobuf_dot_app__config__pb2
+from gateway.goby.protobuf import interprocess_config_pb2 as gateway_dot_goby_dot_protobuf_dot_interprocess__config__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n1behaviors/protobuf/goby_helm_example_config.proto\x12\x13goby3_course.config\x1a!gateway/protobuf/app_config.proto\x1a*gateway/protobuf/interprocess_config.proto\"\xdd\x01\n\x04Helm\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x12\n\x05speed\x18\n \x01(\x01:\x03\x31.5\x12\x15\n\reast_duration\x18\x0b \x02(\x05\x12\x16\n\x0esouth_duration\x18\x0c \x02(\x05\x12\x1a\n\x0e\x63losing_window\x18\x14 \x01(\x05:\x02\x31\x30')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n1behaviors/protobuf/goby_helm_example_config.proto\x12\x13goby3_course.config\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\"\xdd\x01\n\x04Helm\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x12\n\x05speed\x18\n \x01(\x01:\x03\x31.5\x12\x15\n\reast_duration\x18\x0b \x02(\x05\x12\x16\n\x0esouth_duration\x18\x0c \x02(\x05\x12\x1a\n\x0e\x63losing_window\x18\x14 \x01(\x05:\x02\x31\x30')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'behaviors.protobuf.goby_helm_example_config_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_HELM']._serialized_start=154
-  _globals['_HELM']._serialized_end=375
+  _globals['_HELM']._serialized_start=164
+  _globals['_HELM']._serialized_end=385
 # @@protoc_insertion_point(module_scope)

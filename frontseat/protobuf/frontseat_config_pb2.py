@@ -22,17 +22,17 @@ _runtime_version.ValidateProtobufRuntimeVersion(
 _sym_db = _symbol_database.Default()
 
 
-from gateway.protobuf import geographic_pb2 as gateway_dot_protobuf_dot_geographic__pb2
+from gateway.goby.protobuf import geographic_pb2 as gateway_dot_goby_dot_protobuf_dot_geographic__pb2
 from frontseat.protobuf import frontseat_data_pb2 as frontseat_dot_protobuf_dot_frontseat__data__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n)frontseat/protobuf/frontseat_config.proto\x12\"goby.middleware.frontseat.protobuf\x1a!gateway/protobuf/geographic.proto\x1a\'frontseat/protobuf/frontseat_data.proto\"\xd7\x02\n\x06\x43onfig\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x35\n\x06origin\x18\x02 \x01(\x0b\x32%.goby.middleware.protobuf.LatLonPoint\x12\x42\n\x04type\x18\x03 \x01(\x0e\x32/.goby.middleware.frontseat.protobuf.VehicleType:\x03\x41UV\x12\x1a\n\x0crequire_helm\x18\n \x01(\x08:\x04true\x12 \n\x14helm_running_timeout\x18\x0b \x01(\x01:\x02\x31\x30\x12\'\n\x1b\x66rontseat_connected_timeout\x18\x0c \x01(\x01:\x02\x31\x30\x12\x18\n\rstatus_period\x18\r \x01(\r:\x01\x35\x12\x1c\n\rexit_on_error\x18\x15 \x01(\x08:\x05\x66\x61lse\x12\x1a\n\x0fsim_warp_factor\x18\x1e \x01(\x05:\x01\x31*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n)frontseat/protobuf/frontseat_config.proto\x12\"goby.middleware.frontseat.protobuf\x1a&gateway/goby/protobuf/geographic.proto\x1a\'frontseat/protobuf/frontseat_data.proto\"\xd7\x02\n\x06\x43onfig\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x35\n\x06origin\x18\x02 \x01(\x0b\x32%.goby.middleware.protobuf.LatLonPoint\x12\x42\n\x04type\x18\x03 \x01(\x0e\x32/.goby.middleware.frontseat.protobuf.VehicleType:\x03\x41UV\x12\x1a\n\x0crequire_helm\x18\n \x01(\x08:\x04true\x12 \n\x14helm_running_timeout\x18\x0b \x01(\x01:\x02\x31\x30\x12\'\n\x1b\x66rontseat_connected_timeout\x18\x0c \x01(\x01:\x02\x31\x30\x12\x18\n\rstatus_period\x18\r \x01(\r:\x01\x35\x12\x1c\n\rexit_on_error\x18\x15 \x01(\x08:\x05\x66\x61lse\x12\x1a\n\x0fsim_warp_factor\x18\x1e \x01(\x05:\x01\x31*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'frontseat.protobuf.frontseat_config_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_CONFIG']._serialized_start=158
-  _globals['_CONFIG']._serialized_end=501
+  _globals['_CONFIG']._serialized_start=163
+  _globals['_CONFIG']._serialized_end=506
 # @@protoc_insertion_point(module_scope)

@@ -1,4 +1,4 @@
-from gateway.protobuf import geographic_pb2 as _geographic_pb2
+from gateway.goby.protobuf import geographic_pb2 as _geographic_pb2
 from frontseat.protobuf import frontseat_data_pb2 as _frontseat_data_pb2
 from google.protobuf.internal import python_message as _python_message
 from google.protobuf import descriptor as _descriptor

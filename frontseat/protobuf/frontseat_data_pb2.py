@@ -22,40 +22,40 @@ _runtime_version.ValidateProtobufRuntimeVersion(
 _sym_db = _symbol_database.Default()
 
 
-from gateway.protobuf import geographic_pb2 as gateway_dot_protobuf_dot_geographic__pb2
+from gateway.goby.protobuf import geographic_pb2 as gateway_dot_goby_dot_protobuf_dot_geographic__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\'frontseat/protobuf/frontseat_data.proto\x12\"goby.middleware.frontseat.protobuf\x1a!gateway/protobuf/geographic.proto\"\xae\x03\n\nNodeStatus\x12\x0c\n\x04time\x18\x01 \x02(\x01\x12\x0c\n\x04name\x18\x02 \x01(\t\x12=\n\x04type\x18\x03 \x01(\x0e\x32/.goby.middleware.frontseat.protobuf.VehicleType\x12\x39\n\nglobal_fix\x18\n \x02(\x0b\x32%.goby.middleware.protobuf.LatLonPoint\x12J\n\tlocal_fix\x18\x0b \x01(\x0b\x32\x37.goby.middleware.frontseat.protobuf.CartesianCoordinate\x12=\n\x04pose\x18\x14 \x02(\x0b\x32/.goby.middleware.frontseat.protobuf.EulerAngles\x12\x38\n\x05speed\x18\x1e \x02(\x0b\x32).goby.middleware.frontseat.protobuf.Speed\x12:\n\x06source\x18( \x01(\x0b\x32*.goby.middleware.frontseat.protobuf.Source*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\xac\x01\n\rDesiredCourse\x12\x0c\n\x04time\x18\x01 \x02(\x01\x12\x12\n\x07heading\x18\x02 \x01(\x01:\x01\x30\x12\x10\n\x05speed\x18\x03 \x01(\x01:\x01\x30\x12\x10\n\x05\x64\x65pth\x18\x04 \x01(\x01:\x01\x30\x12\x10\n\x05pitch\x18\x05 \x01(\x01:\x01\x30\x12\x0f\n\x04roll\x18\x06 \x01(\x01:\x01\x30\x12\x11\n\x06z_rate\x18\x07 \x01(\x01:\x01\x30\x12\x14\n\x08\x61ltitude\x18\x08 \x01(\x01:\x02\x31\x30*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\xa4\x03\n\x06Source\x12\x43\n\x08position\x18\x01 \x01(\x0e\x32\x31.goby.middleware.frontseat.protobuf.Source.Sensor\x12@\n\x05\x64\x65pth\x18\x02 \x01(\x0e\x32\x31.goby.middleware.frontseat.protobuf.Source.Sensor\x12@\n\x05speed\x18\x03 \x01(\x0e\x32\x31.goby.middleware.frontseat.protobuf.Source.Sensor\x12\x42\n\x07heading\x18\x04 \x01(\x0e\x32\x31.goby.middleware.frontseat.protobuf.Source.Sensor\"\x81\x01\n\x06Sensor\x12\x07\n\x03GPS\x10\x01\x12\x08\n\x04USBL\x10\x02\x12\x07\n\x03LBL\x10\x03\x12\x1e\n\x1aINERTIAL_NAVIGATION_SYSTEM\x10\x04\x12\x0c\n\x08PRESSURE\x10\n\x12\x07\n\x03\x44VL\x10\x14\x12\x0e\n\nRPM_LOOKUP\x10\x1e\x12\x14\n\x10MAGNETIC_COMPASS\x10(*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"D\n\x13\x43\x61rtesianCoordinate\x12\t\n\x01x\x18\x01 \x02(\x01\x12\t\n\x01y\x18\x02 \x02(\x01\x12\x0c\n\x01z\x18\x03 \x01(\x01:\x01\x30*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\x9f\x01\n\x0b\x45ulerAngles\x12\x0c\n\x04roll\x18\x01 \x01(\x01\x12\r\n\x05pitch\x18\x02 \x01(\x01\x12\x0f\n\x07heading\x18\x03 \x01(\x01\x12\x1a\n\x12\x63ourse_over_ground\x18\x04 \x01(\x01\x12\x11\n\troll_rate\x18\n \x01(\x01\x12\x12\n\npitch_rate\x18\x0b \x01(\x01\x12\x14\n\x0cheading_rate\x18\x0c \x01(\x01*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\";\n\x05Speed\x12\x13\n\x0bover_ground\x18\x01 \x02(\x01\x12\x12\n\nover_water\x18\x02 \x01(\x01*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\xe5\x06\n\tCTDSample\x12\x0c\n\x04time\x18\x02 \x02(\x01\x12\x14\n\x0c\x63onductivity\x18\n \x01(\x01\x12\x13\n\x0btemperature\x18\x0b \x02(\x01\x12\x10\n\x08pressure\x18\x0c \x02(\x01\x12\x10\n\x08salinity\x18\x14 \x02(\x01\x12\x13\n\x0bsound_speed\x18\x15 \x02(\x01\x12\x0f\n\x07\x64\x65nsity\x18\x16 \x02(\x01\x12\x39\n\nglobal_fix\x18\x17 \x02(\x0b\x32%.goby.middleware.protobuf.LatLonPoint\x12r\n\x12salinity_algorithm\x18\x1e \x01(\x0e\x32?.goby.middleware.frontseat.protobuf.CTDSample.SalinityAlgorithm:\x15SAL_ALGORITHM_UNKNOWN\x12v\n\x15sound_speed_algorithm\x18\x1f \x01(\x0e\x32\x41.goby.middleware.frontseat.protobuf.CTDSample.SoundSpeedAlgorithm:\x14SS_ALGORITHM_UNKNOWN\x12t\n\x11\x64\x65nsity_algorithm\x18  \x01(\x0e\x32>.goby.middleware.frontseat.protobuf.CTDSample.DensityAlgorithm:\x19\x44\x45NSITY_ALGORITHM_UNKNOWN\"S\n\x11SalinityAlgorithm\x12\x19\n\x15SAL_ALGORITHM_UNKNOWN\x10\x00\x12#\n\x1fUNESCO_44_PREKIN_AND_LEWIS_1980\x10\x01\"}\n\x13SoundSpeedAlgorithm\x12\x18\n\x14SS_ALGORITHM_UNKNOWN\x10\x00\x12#\n\x1fUNESCO_44_CHEN_AND_MILLERO_1977\x10\x01\x12\x12\n\x0eMACKENZIE_1981\x10\x02\x12\x13\n\x0f\x44\x45L_GROSSO_1974\x10\x03\"Y\n\x10\x44\x65nsityAlgorithm\x12\x1d\n\x19\x44\x45NSITY_ALGORITHM_UNKNOWN\x10\x00\x12&\n\"UNESCO_38_MILLERO_AND_POISSON_1981\x10\x01*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"C\n\x0b\x44\x61tumUpdate\x12\x34\n\x05\x64\x61tum\x18\x01 \x02(\x0b\x32%.goby.middleware.protobuf.LatLonPoint*\xd1\x01\n\x0bVehicleType\x12\x0b\n\x07UNKNOWN\x10\x00\x12\x07\n\x03\x41UV\x10\n\x12\n\n\x06GLIDER\x10\x0b\x12\x07\n\x03USV\x10\x14\x12\x0f\n\x0bUSV_POWERED\x10\x15\x12\x0f\n\x0bUSV_SAILING\x10\x16\x12\x07\n\x03ROV\x10\x1e\x12\n\n\x06TARGET\x10\x32\x12\x08\n\x04\x42UOY\x10<\x12\x0b\n\x07MOORING\x10=\x12\x16\n\x12MOORING_SUBSURFACE\x10>\x12\x13\n\x0fMOORING_SURFACE\x10?\x12\x08\n\x04SHIP\x10\x64\x12\x12\n\x05OTHER\x10\xff\xff\xff\xff\xff\xff\xff\xff\xff\x01')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\'frontseat/protobuf/frontseat_data.proto\x12\"goby.middleware.frontseat.protobuf\x1a&gateway/goby/protobuf/geographic.proto\"\xae\x03\n\nNodeStatus\x12\x0c\n\x04time\x18\x01 \x02(\x01\x12\x0c\n\x04name\x18\x02 \x01(\t\x12=\n\x04type\x18\x03 \x01(\x0e\x32/.goby.middleware.frontseat.protobuf.VehicleType\x12\x39\n\nglobal_fix\x18\n \x02(\x0b\x32%.goby.middleware.protobuf.LatLonPoint\x12J\n\tlocal_fix\x18\x0b \x01(\x0b\x32\x37.goby.middleware.frontseat.protobuf.CartesianCoordinate\x12=\n\x04pose\x18\x14 \x02(\x0b\x32/.goby.middleware.frontseat.protobuf.EulerAngles\x12\x38\n\x05speed\x18\x1e \x02(\x0b\x32).goby.middleware.frontseat.protobuf.Speed\x12:\n\x06source\x18( \x01(\x0b\x32*.goby.middleware.frontseat.protobuf.Source*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\xac\x01\n\rDesiredCourse\x12\x0c\n\x04time\x18\x01 \x02(\x01\x12\x12\n\x07heading\x18\x02 \x01(\x01:\x01\x30\x12\x10\n\x05speed\x18\x03 \x01(\x01:\x01\x30\x12\x10\n\x05\x64\x65pth\x18\x04 \x01(\x01:\x01\x30\x12\x10\n\x05pitch\x18\x05 \x01(\x01:\x01\x30\x12\x0f\n\x04roll\x18\x06 \x01(\x01:\x01\x30\x12\x11\n\x06z_rate\x18\x07 \x01(\x01:\x01\x30\x12\x14\n\x08\x61ltitude\x18\x08 \x01(\x01:\x02\x31\x30*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\xa4\x03\n\x06Source\x12\x43\n\x08position\x18\x01 \x01(\x0e\x32\x31.goby.middleware.frontseat.protobuf.Source.Sensor\x12@\n\x05\x64\x65pth\x18\x02 \x01(\x0e\x32\x31.goby.middleware.frontseat.protobuf.Source.Sensor\x12@\n\x05speed\x18\x03 \x01(\x0e\x32\x31.goby.middleware.frontseat.protobuf.Source.Sensor\x12\x42\n\x07heading\x18\x04 \x01(\x0e\x32\x31.goby.middleware.frontseat.protobuf.Source.Sensor\"\x81\x01\n\x06Sensor\x12\x07\n\x03GPS\x10\x01\x12\x08\n\x04USBL\x10\x02\x12\x07\n\x03LBL\x10\x03\x12\x1e\n\x1aINERTIAL_NAVIGATION_SYSTEM\x10\x04\x12\x0c\n\x08PRESSURE\x10\n\x12\x07\n\x03\x44VL\x10\x14\x12\x0e\n\nRPM_LOOKUP\x10\x1e\x12\x14\n\x10MAGNETIC_COMPASS\x10(*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"D\n\x13\x43\x61rtesianCoordinate\x12\t\n\x01x\x18\x01 \x02(\x01\x12\t\n\x01y\x18\x02 \x02(\x01\x12\x0c\n\x01z\x18\x03 \x01(\x01:\x01\x30*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\x9f\x01\n\x0b\x45ulerAngles\x12\x0c\n\x04roll\x18\x01 \x01(\x01\x12\r\n\x05pitch\x18\x02 \x01(\x01\x12\x0f\n\x07heading\x18\x03 \x01(\x01\x12\x1a\n\x12\x63ourse_over_ground\x18\x04 \x01(\x01\x12\x11\n\troll_rate\x18\n \x01(\x01\x12\x12\n\npitch_rate\x18\x0b \x01(\x01\x12\x14\n\x0cheading_rate\x18\x0c \x01(\x01*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\";\n\x05Speed\x12\x13\n\x0bover_ground\x18\x01 \x02(\x01\x12\x12\n\nover_water\x18\x02 \x01(\x01*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\xe5\x06\n\tCTDSample\x12\x0c\n\x04time\x18\x02 \x02(\x01\x12\x14\n\x0c\x63onductivity\x18\n \x01(\x01\x12\x13\n\x0btemperature\x18\x0b \x02(\x01\x12\x10\n\x08pressure\x18\x0c \x02(\x01\x12\x10\n\x08salinity\x18\x14 \x02(\x01\x12\x13\n\x0bsound_speed\x18\x15 \x02(\x01\x12\x0f\n\x07\x64\x65nsity\x18\x16 \x02(\x01\x12\x39\n\nglobal_fix\x18\x17 \x02(\x0b\x32%.goby.middleware.protobuf.LatLonPoint\x12r\n\x12salinity_algorithm\x18\x1e \x01(\x0e\x32?.goby.middleware.frontseat.protobuf.CTDSample.SalinityAlgorithm:\x15SAL_ALGORITHM_UNKNOWN\x12v\n\x15sound_speed_algorithm\x18\x1f \x01(\x0e\x32\x41.goby.middleware.frontseat.protobuf.CTDSample.SoundSpeedAlgorithm:\x14SS_ALGORITHM_UNKNOWN\x12t\n\x11\x64\x65nsity_algorithm\x18  \x01(\x0e\x32>.goby.middleware.frontseat.protobuf.CTDSample.DensityAlgorithm:\x19\x44\x45NSITY_ALGORITHM_UNKNOWN\"S\n\x11SalinityAlgorithm\x12\x19\n\x15SAL_ALGORITHM_UNKNOWN\x10\x00\x12#\n\x1fUNESCO_44_PREKIN_AND_LEWIS_1980\x10\x01\"}\n\x13SoundSpeedAlgorithm\x12\x18\n\x14SS_ALGORITHM_UNKNOWN\x10\x00\x12#\n\x1fUNESCO_44_CHEN_AND_MILLERO_1977\x10\x01\x12\x12\n\x0eMACKENZIE_1981\x10\x02\x12\x13\n\x0f\x44\x45L_GROSSO_1974\x10\x03\"Y\n\x10\x44\x65nsityAlgorithm\x12\x1d\n\x19\x44\x45NSITY_ALGORITHM_UNKNOWN\x10\x00\x12&\n\"UNESCO_38_MILLERO_AND_POISSON_1981\x10\x01*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"C\n\x0b\x44\x61tumUpdate\x12\x34\n\x05\x64\x61tum\x18\x01 \x02(\x0b\x32%.goby.middleware.protobuf.LatLonPoint*\xd1\x01\n\x0bVehicleType\x12\x0b\n\x07UNKNOWN\x10\x00\x12\x07\n\x03\x41UV\x10\n\x12\n\n\x06GLIDER\x10\x0b\x12\x07\n\x03USV\x10\x14\x12\x0f\n\x0bUSV_POWERED\x10\x15\x12\x0f\n\x0bUSV_SAILING\x10\x16\x12\x07\n\x03ROV\x10\x1e\x12\n\n\x06TARGET\x10\x32\x12\x08\n\x04\x42UOY\x10<\x12\x0b\n\x07MOORING\x10=\x12\x16\n\x12MOORING_SUBSURFACE\x10>\x12\x13\n\x0fMOORING_SURFACE\x10?\x12\x08\n\x04SHIP\x10\x64\x12\x12\n\x05OTHER\x10\xff\xff\xff\xff\xff\xff\xff\xff\xff\x01')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'frontseat.protobuf.frontseat_data_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_VEHICLETYPE']._serialized_start=2380
-  _globals['_VEHICLETYPE']._serialized_end=2589
-  _globals['_NODESTATUS']._serialized_start=115
-  _globals['_NODESTATUS']._serialized_end=545
-  _globals['_DESIREDCOURSE']._serialized_start=548
-  _globals['_DESIREDCOURSE']._serialized_end=720
-  _globals['_SOURCE']._serialized_start=723
-  _globals['_SOURCE']._serialized_end=1143
-  _globals['_SOURCE_SENSOR']._serialized_start=1003
-  _globals['_SOURCE_SENSOR']._serialized_end=1132
-  _globals['_CARTESIANCOORDINATE']._serialized_start=1145
-  _globals['_CARTESIANCOORDINATE']._serialized_end=1213
-  _globals['_EULERANGLES']._serialized_start=1216
-  _globals['_EULERANGLES']._serialized_end=1375
-  _globals['_SPEED']._serialized_start=1377
-  _globals['_SPEED']._serialized_end=1436
-  _globals['_CTDSAMPLE']._serialized_start=1439
-  _globals['_CTDSAMPLE']._serialized_end=2308
-  _globals['_CTDSAMPLE_SALINITYALGORITHM']._serialized_start=1996
-  _globals['_CTDSAMPLE_SALINITYALGORITHM']._serialized_end=2079
-  _globals['_CTDSAMPLE_SOUNDSPEEDALGORITHM']._serialized_start=2081
-  _globals['_CTDSAMPLE_SOUNDSPEEDALGORITHM']._serialized_end=2206
-  _globals['_CTDSAMPLE_DENSITYALGORITHM']._serialized_start=2208
-  _globals['_CTDSAMPLE_DENSITYALGORITHM']._serialized_end=2297
-  _globals['_DATUMUPDATE']._serialized_start=2310
-  _globals['_DATUMUPDATE']._serialized_end=2377
+  _globals['_VEHICLETYPE']._serialized_start=2385
+  _globals['_VEHICLETYPE']._serialized_end=2594
+  _globals['_NODESTATUS']._serialized_start=120
+  _globals['_NODESTATUS']._serialized_end=550
+  _globals['_DESIREDCOURSE']._serialized_start=553
+  _globals['_DESIREDCOURSE']._serialized_end=725
+  _globals['_SOURCE']._serialized_start=728
+  _globals['_SOURCE']._serialized_end=1148
+  _globals['_SOURCE_SENSOR']._serialized_start=1008
+  _globals['_SOURCE_SENSOR']._serialized_end=1137
+  _globals['_CARTESIANCOORDINATE']._serialized_start=1150
+  _globals['_CARTESIANCOORDINATE']._serialized_end=1218
+  _globals['_EULERANGLES']._serialized_start=1221
+  _globals['_EULERANGLES']._serialized_end=1380
+  _globals['_SPEED']._serialized_start=1382
+  _globals['_SPEED']._serialized_end=1441
+  _globals['_CTDSAMPLE']._serialized_start=1444
+  _globals['_CTDSAMPLE']._serialized_end=2313
+  _globals['_CTDSAMPLE_SALINITYALGORITHM']._serialized_start=2001
+  _globals['_CTDSAMPLE_SALINITYALGORITHM']._serialized_end=2084
+  _globals['_CTDSAMPLE_SOUNDSPEEDALGORITHM']._serialized_start=2086
+  _globals['_CTDSAMPLE_SOUNDSPEEDALGORITHM']._serialized_end=2211
+  _globals['_CTDSAMPLE_DENSITYALGORITHM']._serialized_start=2213
+  _globals['_CTDSAMPLE_DENSITYALGORITHM']._serialized_end=2302
+  _globals['_DATUMUPDATE']._serialized_start=2315
+  _globals['_DATUMUPDATE']._serialized_end=2382
 # @@protoc_insertion_point(module_scope)

@@ -1,4 +1,4 @@
-from gateway.protobuf import geographic_pb2 as _geographic_pb2
+from gateway.goby.protobuf import geographic_pb2 as _geographic_pb2
 from google.protobuf.internal import enum_type_wrapper as _enum_type_wrapper
 from google.protobuf.internal import python_message as _python_message
 from google.protobuf import descriptor as _descriptor

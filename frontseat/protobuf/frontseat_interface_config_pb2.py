@@ -22,18 +22,18 @@ _runtime_version.ValidateProtobufRuntimeVersion(
 _sym_db = _symbol_database.Default()
 
 
-from gateway.protobuf import app_config_pb2 as gateway_dot_protobuf_dot_app__config__pb2
-from gateway.protobuf import interprocess_config_pb2 as gateway_dot_protobuf_dot_interprocess__config__pb2
+from gateway.goby.protobuf import app_config_pb2 as gateway_dot_goby_dot_protobuf_dot_app__config__pb2
+from gateway.goby.protobuf import interprocess_config_pb2 as gateway_dot_goby_dot_protobuf_dot_interprocess__config__pb2
 from frontseat.protobuf import frontseat_config_pb2 as frontseat_dot_protobuf_dot_frontseat__config__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n3frontseat/protobuf/frontseat_interface_config.proto\x12\x19goby.apps.zeromq.protobuf\x1a!gateway/protobuf/app_config.proto\x1a*gateway/protobuf/interprocess_config.proto\x1a)frontseat/protobuf/frontseat_config.proto\"\xe0\x01\n\x18\x46rontSeatInterfaceConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x41\n\rfrontseat_cfg\x18\n \x02(\x0b\x32*.goby.middleware.frontseat.protobuf.Config*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n3frontseat/protobuf/frontseat_interface_config.proto\x12\x19goby.apps.zeromq.protobuf\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\x1a)frontseat/protobuf/frontseat_config.proto\"\xe0\x01\n\x18\x46rontSeatInterfaceConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x41\n\rfrontseat_cfg\x18\n \x02(\x0b\x32*.goby.middleware.frontseat.protobuf.Config*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'frontseat.protobuf.frontseat_interface_config_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_FRONTSEATINTERFACECONFIG']._serialized_start=205
-  _globals['_FRONTSEATINTERFACECONFIG']._serialized_end=429
+  _globals['_FRONTSEATINTERFACECONFIG']._serialized_start=215
+  _globals['_FRONTSEATINTERFACECONFIG']._serialized_end=439
 # @@protoc_insertion_point(module_scope)

@@ -22,11 +22,11 @@ _runtime_version.ValidateProtobufRuntimeVersion(
 _sym_db = _symbol_database.Default()
 
 
-from gateway.protobuf import moos_gateway_config_pb2 as gateway_dot_protobuf_dot_moos__gateway__config__pb2
+from gateway.moos_gateway.protobuf import moos_gateway_config_pb2 as gateway_dot_moos__gateway_dot_protobuf_dot_moos__gateway__config__pb2
 from frontseat.protobuf import frontseat_interface_config_pb2 as frontseat_dot_protobuf_dot_frontseat__interface__config__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n=frontseat/protobuf/moos_helm_frontseat_interface_config.proto\x12\x12goby.moos.protobuf\x1a*gateway/protobuf/moos_gateway_config.proto\x1a\x33\x66rontseat/protobuf/frontseat_interface_config.proto:\x82\x01\n\tmoos_helm\x12\x33.goby.apps.zeromq.protobuf.FrontSeatInterfaceConfig\x18\xe8\x07 \x01(\x0b\x32\x39.goby.apps.moos.protobuf.GobyMOOSGatewayConfig.MOOSConfig')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n=frontseat/protobuf/moos_helm_frontseat_interface_config.proto\x12\x12goby.moos.protobuf\x1a\x37gateway/moos_gateway/protobuf/moos_gateway_config.proto\x1a\x33\x66rontseat/protobuf/frontseat_interface_config.proto:\x82\x01\n\tmoos_helm\x12\x33.goby.apps.zeromq.protobuf.FrontSeatInterfaceConfig\x18\xe8\x07 \x01(\x0b\x32\x39.goby.apps.moos.protobuf.GobyMOOSGatewayConfig.MOOSConfig')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)

@@ -22,16 +22,16 @@ _runtime_version.ValidateProtobufRuntimeVersion(
 _sym_db = _symbol_database.Default()
 
 
-from gateway.protobuf import geographic_pb2 as gateway_dot_protobuf_dot_geographic__pb2
+from gateway.goby.protobuf import geographic_pb2 as gateway_dot_goby_dot_protobuf_dot_geographic__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n#frontseat/protobuf/navigation.proto\x12\x18goby.middleware.protobuf\x1a!gateway/protobuf/geographic.proto\"C\n\x0b\x44\x61tumUpdate\x12\x34\n\x05\x64\x61tum\x18\x01 \x02(\x0b\x32%.goby.middleware.protobuf.LatLonPoint')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n#frontseat/protobuf/navigation.proto\x12\x18goby.middleware.protobuf\x1a&gateway/goby/protobuf/geographic.proto\"C\n\x0b\x44\x61tumUpdate\x12\x34\n\x05\x64\x61tum\x18\x01 \x02(\x0b\x32%.goby.middleware.protobuf.LatLonPoint')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'frontseat.protobuf.navigation_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_DATUMUPDATE']._serialized_start=100
-  _globals['_DATUMUPDATE']._serialized_end=167
+  _globals['_DATUMUPDATE']._serialized_start=105
+  _globals['_DATUMUPDATE']._serialized_end=172
 # @@protoc_insertion_point(module_scope)

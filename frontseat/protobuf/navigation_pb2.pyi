@@ -1,4 +1,4 @@
-from gateway.protobuf import geographic_pb2 as _geographic_pb2
+from gateway.goby.protobuf import geographic_pb2 as _geographic_pb2
 from google.protobuf import descriptor as _descriptor
 from google.protobuf import message as _message
 from collections.abc import Mapping as _Mapping

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 
 from frontseat.simulator import protocol
 from frontseat.simulator.protocol import INT_MAX, ProtocolError
-from gateway.geodesy import UTMGeodesy
+from util.geodesy import UTMGeodesy
 
 log = logging.getLogger(__name__)
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 from frontseat.simulator.model import Simulation
 from frontseat.simulator.protocol import DELIMITER
-from gateway.logsetup import add_verbosity_argument, configure_logging
+from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
 

@@ -14,7 +14,8 @@ import signal
 import sys
 from pathlib import Path
 
-from ..logsetup import add_verbosity_argument, configure_logging
+from util.logsetup import add_verbosity_argument, configure_logging
+
 from .errors import MissionFileError
 from .mission_file import MissionFile
 from .server import MoosDB

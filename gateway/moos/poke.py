@@ -13,7 +13,8 @@ import re
 import sys
 import time
 
-from ..logsetup import add_verbosity_argument, configure_logging
+from util.logsetup import add_verbosity_argument, configure_logging
+
 from .client import comms
 from .clock import MAX_WARP, MoosClock
 from .tool_args import add_server_arguments, resolve_server, split_mission_file

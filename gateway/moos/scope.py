@@ -16,7 +16,8 @@ import sys
 import threading
 import time
 
-from ..logsetup import add_verbosity_argument, configure_logging
+from util.logsetup import add_verbosity_argument, configure_logging
+
 from .client import comms
 from .clock import MoosClock
 from .message import MoosMessage

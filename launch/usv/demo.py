@@ -22,7 +22,6 @@ import tempfile
 import time
 from pathlib import Path
 
-from gateway.logsetup import add_verbosity_argument, configure_logging
 from launch.config import free_tcp_port
 from launch.errors import ConfigError, LaunchError
 from launch.usv.analysis import bhv_waypoints, command_effects, loiter_phases, transitions
@@ -31,6 +30,7 @@ from launch.usv.plot import write_track_png
 from launch.usv.settings import DEFAULT_SCHEDULE, KAUAI_ORIGIN, UsvSettings
 from launch.usv.shore import SCHEDULE_HELP, parse_schedule
 from launch.usv.summary import progress_line, summary_text
+from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
 

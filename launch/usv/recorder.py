@@ -15,9 +15,9 @@ from typing import Any
 
 from frontseat import groups as frontseat_groups
 from frontseat.protobuf.frontseat_pb2 import InterfaceState, InterfaceStatus
+from gateway.goby.portal import SimpleThread
 from gateway.moos import MoosClock, comms
-from gateway.portal import SimpleThread
-from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from launch.usv.record import MissionRecord
 from launch.usv.settings import UsvSettings
 

@@ -26,11 +26,11 @@ from google.protobuf import text_format
 
 from frontseat import groups as frontseat_groups
 from frontseat.protobuf.frontseat_pb2 import INTERFACE_COMMAND, InterfaceStatus
-from gateway.portal import SingleThreadApplication, clock, run_application
+from gateway.goby.portal import SingleThreadApplication, clock, run_application
 from launch.errors import ConfigError
 from launch.usv.settings import DEFAULT_SCHEDULE
+from translators.apps.usv_command import describe_ack
 from translators.usv import groups as usv_groups
-from translators.usv.command_cli import describe_ack
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from translators.usv.protobuf.usv_config_pb2 import CommandTool

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import sys
 
-from behaviors.helm import app
+from behaviors.apps import ivp_helm as app
 from behaviors.helm.helm import Helm, Post
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from behaviors.helm.app import HelmApp
+from behaviors.apps.ivp_helm import HelmApp
 from gateway.moos import MoosClock
 from gateway.moos.testing import running_moosdb
 

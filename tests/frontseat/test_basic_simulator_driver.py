@@ -15,7 +15,7 @@ from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.simulator.server import SimulatorServer
 from frontseat.testing import wait_until
-from gateway.geodesy import UTMGeodesy
+from util.geodesy import UTMGeodesy
 
 ORIGIN = (41.592344, -70.711260)
 

@@ -13,7 +13,7 @@ from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_interface_config_pb2 as app_pb
 from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.protobuf import moos_helm_frontseat_interface_config_pb2 as helm_pb
-from gateway.protobuf import geographic_pb2 as geo_pb
+from gateway.goby.protobuf import geographic_pb2 as geo_pb
 
 GOBY_GROUPS = {
     "node_status", "desired_course", "raw_in", "raw_out", "raw_send_request", "command_request",

@@ -17,7 +17,7 @@ from frontseat import groups
 from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.testing import SimulatorProcess, basic_simulator_frontseat_cfg, free_tcp_port, start_simulator
-from gateway.portal.testing import AppProcess, PortalClient, broker_process
+from gateway.goby.portal.testing import AppProcess, PortalClient, broker_process
 
 WARP = 10
 HELM_TIMEOUT = 60.0  # simulated seconds: 6 s real at warp 10 (counted from start: room for a slow start)

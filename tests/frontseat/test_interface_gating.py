@@ -15,7 +15,7 @@ from frontseat.protobuf import frontseat_interface_config_pb2 as app_pb
 from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.protobuf import navigation_pb2 as nav_pb
 from frontseat.testing import wait_until
-from gateway.portal.testing import PortalClient, broker_process, running_app
+from gateway.goby.portal.testing import PortalClient, broker_process, running_app
 
 STATUS_PERIOD = 5
 HELM_TIMEOUT = 30.0
@@ -173,7 +173,7 @@ def test_moos_helm_block_without_the_translator_fails_clearly(tmp_path: Path, mo
     from frontseat.errors import FrontSeatException
     from frontseat.protobuf import moos_helm_frontseat_interface_config_pb2 as helm_pb
 
-    monkeypatch.setitem(sys.modules, "translators.frontseat_translation", None)  # import now raises ImportError
+    monkeypatch.setitem(sys.modules, "translators.frontseat.translation", None)  # import now raises ImportError
     built: list[ScriptedDriverDouble] = []
 
     def factory(cfg: config_pb.Config) -> ScriptedDriverDouble:

@@ -13,8 +13,8 @@ from pathlib import Path
 from frontseat import groups
 from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.testing import basic_simulator_frontseat_cfg, running_simulator
+from gateway.goby.portal.testing import AppProcess, PortalClient, broker_process
 from gateway.moos.testing import connected_comms, running_moosdb
-from gateway.portal.testing import AppProcess, PortalClient, broker_process
 
 WARP = 10
 

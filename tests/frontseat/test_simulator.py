@@ -12,7 +12,7 @@ from frontseat.simulator import protocol
 from frontseat.simulator.model import Simulation
 from frontseat.simulator.server import SimulatorServer
 from frontseat.testing import SimClient, running_simulator, wait_until
-from gateway.geodesy import UTMGeodesy
+from util.geodesy import UTMGeodesy
 
 LAT, LON = 41.592344, -70.71126
 

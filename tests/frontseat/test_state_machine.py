@@ -407,7 +407,7 @@ def test_at_most_one_transition_per_tick_through_a_full_recovery() -> None:
 
 def test_compute_missing_fills_local_fix_from_global_and_back() -> None:
     from frontseat.protobuf import frontseat_data_pb2 as data_pb
-    from gateway.geodesy import UTMGeodesy
+    from util.geodesy import UTMGeodesy
 
     clock = FakeClock(1234.5)
     cfg = config_pb.Config(name="usv", type=20)

@@ -14,8 +14,8 @@ import pytest
 from gateway_plugin_sources import ECHO_PLUGIN
 from moosdb_kinds import any_moosdb, real_moosdb_skip_reason
 
+from gateway.goby.portal.testing import PortalClient, broker_process
 from gateway.moos.testing import collect_mail, connected_comms, moosdb_process
-from gateway.portal.testing import PortalClient, broker_process
 from translators.moos_interface import TIME_VAR
 from translators.testing import GatewayProcess
 

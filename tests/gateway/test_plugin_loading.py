@@ -12,8 +12,9 @@ from pathlib import Path
 import pytest
 from gateway_plugin_sources import ECHO_PLUGIN, IMPORT_ERROR_PLUGIN, NO_LOAD_PLUGIN, RAISING_LOAD_PLUGIN
 
+from gateway.goby.portal.testing import broker_process
 from gateway.moos.testing import running_moosdb
-from gateway.plugins import (
+from gateway.moos_gateway.plugins import (
     ENV_VAR,
     PluginError,
     _entry_point,
@@ -23,7 +24,6 @@ from gateway.plugins import (
     resolve_plugins,
     split_plugin_list,
 )
-from gateway.portal.testing import broker_process
 
 
 def test_split_on_any_delimiter_keeping_empty_entries():
@@ -56,15 +56,15 @@ def test_resolve_file_and_dotted_module(tmp_path, monkeypatch):
 def test_entry_points_are_selected_by_name_only():
     names = entry_point_names()
     assert {"frontseat", "usv_command", "node_report"} <= set(names)
-    assert _entry_point("frontseat").value == "translators.frontseat_translation"
+    assert _entry_point("frontseat").value == "translators.frontseat.translation"
     # Goby's library file name is an alias of ours
-    assert _entry_point("libgoby_ivp_frontseat_moos_gateway_plugin.so").value == "translators.frontseat_translation"
-    assert _entry_point("translators.frontseat_translation") is None  # a dotted name is a module, not an entry point
+    assert _entry_point("libgoby_ivp_frontseat_moos_gateway_plugin.so").value == "translators.frontseat.translation"
+    assert _entry_point("translators.frontseat.translation") is None  # a dotted name is a module, not an entry point
 
 
 def test_goby_library_path_loads_our_frontseat_plugin():
     plugin = resolve_plugin("/usr/lib/x86_64-linux-gnu/libgoby_ivp_frontseat_moos_gateway_plugin.so.30")
-    assert plugin.module.__name__ == "translators.frontseat_translation" and callable(plugin.load)
+    assert plugin.module.__name__ == "translators.frontseat.translation" and callable(plugin.load)
 
 
 @pytest.mark.parametrize(
@@ -95,7 +95,7 @@ def _run_gateway(tmp_path: Path, plugins: str | None, config: str, timeout: floa
         env[ENV_VAR] = plugins
     cfg = tmp_path / "gateway.pb.cfg"
     cfg.write_text(config)
-    return subprocess.run([sys.executable, "-m", "gateway.moos_gateway", str(cfg)], env=env, capture_output=True,
+    return subprocess.run([sys.executable, "-m", "gateway.moos_gateway.app", str(cfg)], env=env, capture_output=True,
                           text=True, timeout=timeout, cwd=tmp_path)
 
 
@@ -134,7 +134,7 @@ def test_exception_in_load_stops_what_earlier_plugins_started(tmp_path):
 
 def test_example_config_needs_no_plugins(tmp_path):
     env = {k: v for k, v in os.environ.items() if k != ENV_VAR}
-    result = subprocess.run([sys.executable, "-m", "gateway.moos_gateway", "--example_config"], env=env,
+    result = subprocess.run([sys.executable, "-m", "gateway.moos_gateway.app", "--example_config"], env=env,
                             capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     assert "moos {" in result.stdout and "poll_frequency" in result.stdout

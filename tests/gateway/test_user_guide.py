@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from gateway.plugins import resolve_plugin
+from gateway.moos_gateway.plugins import resolve_plugin
 
 GUIDE = Path(__file__).resolve().parents[2] / "docs" / "writing_a_translator.md"
 

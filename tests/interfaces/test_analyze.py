@@ -9,14 +9,14 @@ from pathlib import Path
 
 import pytest
 
-from gateway.interfaces.analyze import AnalysisError, analyze_modules
+from launch.interfaces.analyze import AnalysisError, analyze_modules
 
 PREAMBLE = """
 from __future__ import annotations
 from frontseat import groups
 from frontseat.protobuf.frontseat_pb2 import InterfaceData, HelmStateReport
 from frontseat.protobuf.frontseat_data_pb2 import DesiredCourse, NodeStatus
-from gateway.portal import Group, SimpleThread
+from gateway.goby.portal import Group, SimpleThread
 
 custom = Group("test::custom", 3)
 
@@ -89,7 +89,7 @@ def test_finds_calls_and_resolves_types_every_supported_way(write_module) -> Non
     }
     interface = analyze_modules("app", [module])
     thread = f"{module}.Helm"
-    assert interface.threads[thread].bases[0] == "gateway.portal.thread.SimpleThread"
+    assert interface.threads[thread].bases[0] == "gateway.goby.portal.thread.SimpleThread"
 
 
 def test_regex_subscription_records_its_patterns(write_module) -> None:

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from gateway.interfaces.drift import covered_threads, drift_problems
-from gateway.interfaces.model import ApplicationInterface, PubSubEntry
-from gateway.portal.interface_registry import InterfaceEntry
+from gateway.goby.portal.interface_registry import InterfaceEntry
+from launch.interfaces.drift import covered_threads, drift_problems
+from launch.interfaces.model import ApplicationInterface, PubSubEntry
 
 G = "goby::middleware::frontseat::node_status"
 T = "goby.middleware.frontseat.protobuf.NodeStatus"

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from gateway.interfaces.interface_yaml import InterfaceFileError, dumps, loads
-from gateway.interfaces.model import ApplicationInterface, PubSubEntry
+from launch.interfaces.interface_yaml import InterfaceFileError, dumps, loads
+from launch.interfaces.model import ApplicationInterface, PubSubEntry
 
-THREAD = "translators.frontseat_translation.FrontSeatTranslation"
+THREAD = "translators.frontseat.translation.FrontSeatTranslation"
 DESIRED = ("goby::middleware::frontseat::desired_course", "goby::middleware::frontseat::protobuf::DesiredCourse")
 NODE = ("goby::middleware::frontseat::node_status", "goby::middleware::frontseat::protobuf::NodeStatus")
 

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from gateway.interfaces.analyze import analyze_modules
-from gateway.interfaces.catalog import SHIPPED_APPLICATIONS
-from gateway.interfaces.cli import generate_text, interface_file_name
-from gateway.interfaces.deployment import DEFAULT_INTERFACES_DIR, load_deployment
-from gateway.interfaces.visualize import VizOptions, build_graph
+from launch.interfaces.analyze import analyze_modules
+from launch.interfaces.catalog import SHIPPED_APPLICATIONS
+from launch.interfaces.cli import generate_text, interface_file_name
+from launch.interfaces.deployment import DEFAULT_INTERFACES_DIR, load_deployment
+from launch.interfaces.visualize import VizOptions, build_graph
 
 FS = "goby::middleware::frontseat::"
 PB = "goby::middleware::frontseat::protobuf::"

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from gateway.interfaces.cli import main as cli_main
-from gateway.interfaces.deployment import DeploymentError, load_deployment
-from gateway.interfaces.interface_yaml import dumps
-from gateway.interfaces.model import ApplicationInterface, PubSubEntry
-from gateway.interfaces.visualize import VizOptions, build_graph, escape_id, to_dot
+from launch.interfaces.cli import main as cli_main
+from launch.interfaces.deployment import DeploymentError, load_deployment
+from launch.interfaces.interface_yaml import dumps
+from launch.interfaces.model import ApplicationInterface, PubSubEntry
+from launch.interfaces.visualize import VizOptions, build_graph, escape_id, to_dot
 
 FS = "goby::middleware::frontseat::"
 PB = "goby::middleware::frontseat::protobuf::"

@@ -11,9 +11,9 @@ from google.protobuf import text_format
 import frontseat.protobuf.basic_simulator_config_pb2 as basic_sim_pb
 import frontseat.protobuf.moos_helm_frontseat_interface_config_pb2 as moos_helm_pb
 from frontseat.protobuf.frontseat_interface_config_pb2 import FrontSeatInterfaceConfig
+from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
 from gateway.moos.mission_file import MissionFile
-from gateway.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
-from gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from launch.errors import ConfigError
 from launch.launchfile import parse_file
 from launch.usv.config import GENERATORS, generate, write_moos_file
@@ -99,7 +99,7 @@ def test_launch_file_has_every_component_in_order():
         assert piece in commands
     env = {k: v for e in entries for k, v in e.env}
     assert env["FRONTSEAT_DRIVER_LIBRARY"] == "basic_simulator"
-    assert env["GOBY_MOOS_GATEWAY_PLUGINS"] == "translators.command_translation"
+    assert env["GOBY_MOOS_GATEWAY_PLUGINS"] == "translators.usv.command_translation"
 
 
 def test_schedule_parsing():

@@ -12,13 +12,13 @@ from pathlib import Path
 
 import pytest
 
-from gateway.interfaces.deployment import DEFAULT_INTERFACES_DIR
-from gateway.interfaces.drift import covered_threads, drift_problems
-from gateway.interfaces.interface_yaml import load as load_interface
+from gateway.goby.portal.interface_registry import ENV_VAR as REGISTRY_ENV
+from gateway.goby.portal.interface_registry import read_entries
 from gateway.moos.testing import real_moos_skip_reason
-from gateway.portal.interface_registry import ENV_VAR as REGISTRY_ENV
-from gateway.portal.interface_registry import read_entries
 from launch.config import free_tcp_port
+from launch.interfaces.deployment import DEFAULT_INTERFACES_DIR
+from launch.interfaces.drift import covered_threads, drift_problems
+from launch.interfaces.interface_yaml import load as load_interface
 from launch.usv.analysis import (
     bhv_waypoints,
     command_effects,

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from gateway.portal.testing import BrokerProcess, broker_process
+from gateway.goby.portal.testing import BrokerProcess, broker_process
 
 
 @pytest.fixture

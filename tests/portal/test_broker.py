@@ -9,20 +9,20 @@ from pathlib import Path
 import pytest
 import zmq
 
-from gateway.portal import BrokerUnavailableError
-from gateway.portal.broker import Broker, BrokerError
-from gateway.portal.identifier import thread_id
-from gateway.portal.manager_client import request_endpoints
-from gateway.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
-from gateway.portal.protobuf.test_messages_pb2 import Sample
-from gateway.portal.testing import BrokerProcess, PortalClient, broker_process
-from gateway.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
-from gateway.protobuf.interprocess_zeromq_pb2 import (
+from gateway.goby.portal import BrokerUnavailableError
+from gateway.goby.portal.broker import Broker, BrokerError
+from gateway.goby.portal.identifier import thread_id
+from gateway.goby.portal.manager_client import request_endpoints
+from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
+from gateway.goby.portal.testing import BrokerProcess, PortalClient, broker_process
+from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from gateway.goby.protobuf.interprocess_zeromq_pb2 import (
     PROVIDE_HOLD_STATE,
     PROVIDE_PUB_SUB_SOCKETS,
     ManagerRequest,
     Socket,
 )
+from tests.protobuf.sample_messages_pb2 import Sample
 
 SAMPLE = "goby.test.zeromq.protobuf.Sample"
 
@@ -88,7 +88,7 @@ def test_raw_subscriber_sees_goby_identifier_bytes(broker: BrokerProcess) -> Non
 def test_malformed_frames_are_logged_and_the_client_keeps_serving(
     broker: BrokerProcess, caplog: pytest.LogCaptureFixture
 ) -> None:
-    caplog.set_level(logging.ERROR, logger="gateway.portal.interprocess")
+    caplog.set_level(logging.ERROR, logger="gateway.goby.portal.interprocess")
     with zmq.Context() as zctx, PortalClient(broker.interprocess_config(), "victim") as client:
         got = client.collect("bad", Sample)
         assert client.wait_subscribed()
@@ -202,7 +202,7 @@ def _garbage_then_valid(broker: BrokerProcess) -> None:
 
 def test_a_goby_style_raw_client_completes_the_hold_handshake(tmp_path: Path) -> None:
     """What a C++ Goby3 client does (spec §4.7), in raw ZeroMQ: sockets over REQ, hold over pub/sub."""
-    from gateway.protobuf.interprocess_zeromq_pb2 import ManagerResponse
+    from gateway.goby.protobuf.interprocess_zeromq_pb2 import ManagerResponse
 
     hold = ["--hold", 'required_client: "goby_app"']
     with broker_process(tmp_path, platform="raw_goby", extra_args=hold) as broker, zmq.Context() as zctx:

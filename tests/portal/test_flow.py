@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from gateway.portal.protobuf.test_messages_pb2 import Sample
-from gateway.portal.testing import BrokerProcess, PortalClient, broker_process
+from gateway.goby.portal.testing import BrokerProcess, PortalClient, broker_process
+from tests.protobuf.sample_messages_pb2 import Sample
 
 
 def test_slow_subscriber_does_not_block_publisher_or_fast_subscriber(broker: BrokerProcess) -> None:
@@ -32,7 +32,7 @@ def test_slow_subscriber_does_not_block_publisher_or_fast_subscriber(broker: Bro
 
 
 def test_tcp_broker_restart_is_rejoined_on_new_ports(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
-    caplog.set_level(logging.INFO, logger="gateway.portal.interprocess")
+    caplog.set_level(logging.INFO, logger="gateway.goby.portal.interprocess")
     with broker_process(tmp_path, platform="tcp_restart", tcp=True) as broker:
         cfg = broker.interprocess_config()
         with PortalClient(cfg, "tcp_rx") as rx, PortalClient(cfg, "tcp_tx") as tx:

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from gateway.portal import Group, InvalidGroupError, MarshallingError, Scheme
-from gateway.portal.group import INVALID_NUMERIC_GROUP, as_group, check_named
-from gateway.portal.marshalling import (
+from gateway.goby.portal import Group, InvalidGroupError, MarshallingError, Scheme
+from gateway.goby.portal.group import INVALID_NUMERIC_GROUP, as_group, check_named
+from gateway.goby.portal.marshalling import (
     default_scheme,
     interprocess_scheme,
     is_dccl,
@@ -17,7 +17,7 @@ from gateway.portal.marshalling import (
     serialize,
     type_name,
 )
-from gateway.portal.protobuf.test_messages_pb2 import DCCLSample, Sample
+from tests.protobuf.sample_messages_pb2 import DCCLSample, Sample
 
 
 def test_group_wire_strings() -> None:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from gateway.portal import IdentifierError
-from gateway.portal.identifier import decode_frame, encode_frame, make_identifier, thread_id, type_prefix
+from gateway.goby.portal import IdentifierError
+from gateway.goby.portal.identifier import decode_frame, encode_frame, make_identifier, thread_id, type_prefix
 
 
 def test_identifier_forms_match_goby() -> None:

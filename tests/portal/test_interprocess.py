@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
-from gateway.portal import Scheme
-from gateway.portal.marshalling import parse_dynamic
-from gateway.portal.protobuf.test_messages_pb2 import DCCLSample, Sample, Widget
-from gateway.portal.testing import AppProcess, BrokerProcess, PortalClient, broker_process
+from gateway.goby.portal import Scheme
+from gateway.goby.portal.marshalling import parse_dynamic
+from gateway.goby.portal.testing import AppProcess, BrokerProcess, PortalClient, broker_process
+from tests.protobuf.sample_messages_pb2 import DCCLSample, Sample, Widget
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -119,7 +119,7 @@ def test_unsubscribe_stops_delivery(broker: BrokerProcess) -> None:
 def test_broker_killed_and_restarted_mid_stream(
     broker: BrokerProcess, tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
-    caplog.set_level(logging.INFO, logger="gateway.portal.interprocess")
+    caplog.set_level(logging.INFO, logger="gateway.goby.portal.interprocess")
     with PortalClient(broker.interprocess_config(), "restart_rx") as rx:
         got = rx.collect("stream", Sample)
         assert rx.wait_subscribed()

@@ -12,7 +12,7 @@ from typing import Any
 
 import pytest
 
-from gateway.portal import (
+from gateway.goby.portal import (
     InvalidGroupError,
     MultiThreadApplication,
     SimpleThread,
@@ -20,9 +20,9 @@ from gateway.portal import (
     SystemClock,
     ThreadError,
 )
-from gateway.portal.interface_registry import ENV_VAR, read_entries
-from gateway.portal.protobuf.test_messages_pb2 import Sample, SampleAppConfig
-from gateway.portal.testing import AppProcess, BrokerProcess, PortalClient, running_app
+from gateway.goby.portal.interface_registry import ENV_VAR, read_entries
+from gateway.goby.portal.testing import AppProcess, BrokerProcess, PortalClient, running_app
+from tests.protobuf.sample_messages_pb2 import Sample, SampleAppConfig
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -48,7 +48,7 @@ class Worker(SimpleThread):
 
 def no_interprocess_cfg() -> Any:
     """An app config type without an interprocess field, so the app needs no broker."""
-    from gateway.protobuf.app_config_pb2 import AppConfig
+    from gateway.goby.protobuf.app_config_pb2 import AppConfig
 
     return AppConfig(name="standalone")
 
@@ -200,7 +200,7 @@ def test_non_main_thread_uses_interprocess_with_callbacks_on_its_thread(broker: 
         worker = app.worker
     assert {t for _, t in worker.got} == {worker.ident}
     assert answers[0].a % 10 == 0
-    from gateway.portal import process_registry
+    from gateway.goby.portal import process_registry
 
     entries = {(e.layer, e.direction, e.group, e.scheme, e.type, e.thread) for e in process_registry.entries()}
     assert ("interprocess", "subscribe", "from_test", "PROTOBUF", "goby.test.zeromq.protobuf.Sample",
@@ -287,7 +287,7 @@ class EarlyApp(MultiThreadApplication):
 
 
 def test_publications_of_a_launched_thread_wait_for_the_hold(tmp_path: Path) -> None:
-    from gateway.portal.testing import broker_process
+    from gateway.goby.portal.testing import broker_process
 
     hold = ["--hold", 'required_client: "early_app" required_client: "early_rx"']
     with broker_process(tmp_path, platform="early", extra_args=hold) as broker, \

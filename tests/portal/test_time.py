@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from gateway.portal.timeutil import (
+from gateway.goby.portal.timeutil import (
     NOT_A_DATE_TIME,
     SystemClock,
     datetime_to_micro,

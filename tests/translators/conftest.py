@@ -23,8 +23,8 @@ from translator_procs import (
     wait_until,
 )
 
+from gateway.goby.portal.testing import BrokerProcess, PortalClient, broker_process
 from gateway.moos.testing import connected_comms, real_moos_skip_reason
-from gateway.portal.testing import BrokerProcess, PortalClient, broker_process
 from translators.usv import groups as usv_groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
@@ -91,7 +91,7 @@ def stack(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFacto
         built.children.append(exits.enter_context(
             running("moos_gateway", gateway_args(port), workdir, plugin_env(broker.env(), PLUGINS))))
         built.children.append(exits.enter_context(
-            running("usv_manager", [sys.executable, "-m", "translators.usv.manager", "-vv"], workdir, broker.env())))
+            running("usv_manager", [sys.executable, "-m", "translators.apps.usv_manager", "-vv"], workdir, broker.env())))
         _probe_translator_clients(built)
         _probe_command_path(built)
         yield built

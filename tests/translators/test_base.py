@@ -11,10 +11,10 @@ from typing import Any
 
 import pytest
 
+from gateway.goby.portal.testing import PortalClient, broker_process
+from gateway.goby.protobuf.app_config_pb2 import AppConfig
 from gateway.moos.message import NOTIFY, MoosMessage
 from gateway.moos.testing import collect_mail, connected_comms, running_moosdb
-from gateway.portal.testing import PortalClient, broker_process
-from gateway.protobuf.app_config_pb2 import AppConfig
 from translators.base import Translator
 from translators.moos_interface import TIME_VAR, MOOSInterface, time_string
 from translators.techniques import Technique
@@ -122,7 +122,7 @@ class FailingTranslator(Translator):
 
 
 def test_failing_constructor_leaves_nothing_running(infrastructure):
-    from gateway.moos_gateway import PluginLoadError
+    from gateway.moos_gateway.app import PluginLoadError
 
     db, broker = infrastructure
     cfg = gateway_config(db.port, broker.interprocess_config())
@@ -248,7 +248,7 @@ class PymoosTranslator(Translator):
 
 def test_asking_for_the_real_pymoos_when_missing_is_a_clear_error(infrastructure):
     from gateway.moos.factory import pymoos_available
-    from gateway.moos_gateway import PluginLoadError
+    from gateway.moos_gateway.app import PluginLoadError
 
     if pymoos_available():
         pytest.skip("the real pymoos is installed here")

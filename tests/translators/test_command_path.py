@@ -6,9 +6,9 @@ import time
 
 from translator_procs import run_cli
 
+from gateway.goby.portal.testing import PortalClient
 from gateway.moos.message import MoosMessage
 from gateway.moos.testing import connected_comms
-from gateway.portal.testing import PortalClient
 from translators.usv import groups as usv_groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand

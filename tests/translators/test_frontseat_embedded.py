@@ -11,10 +11,10 @@ import pytest
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
 from frontseat.protobuf.navigation_pb2 import DatumUpdate
+from gateway.goby.portal import MultiThreadApplication, ProcessContext, use_context
+from gateway.goby.portal.testing import PortalClient, broker_process
 from gateway.moos.testing import connected_comms, running_moosdb
-from gateway.portal import MultiThreadApplication, ProcessContext, use_context
-from gateway.portal.testing import PortalClient, broker_process
-from translators.frontseat_translation import FrontSeatTranslation
+from translators.frontseat.translation import FrontSeatTranslation
 from translators.testing import gateway_config
 from translators.usv.protobuf.usv_config_pb2 import USVManager as HostConfig
 

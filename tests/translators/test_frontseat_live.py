@@ -14,9 +14,9 @@ import pytest
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import USV, DesiredCourse, NodeStatus
 from frontseat.protobuf.frontseat_pb2 import HELM_DRIVE, HELM_NOT_RUNNING, HELM_PARK, HelmStateReport
+from gateway.goby.portal.testing import PortalClient, broker_process
 from gateway.moos.testing import connected_comms, running_moosdb
-from gateway.portal.testing import PortalClient, broker_process
-from translators.frontseat_translation import FrontSeatTranslation
+from translators.frontseat.translation import FrontSeatTranslation
 from translators.testing import gateway_config, hosted_translators
 
 NAV_VARS = ["NAV_X", "NAV_Y", "NAV_LAT", "NAV_LONG", "NAV_DEPTH", "NAV_HEADING", "NAV_YAW", "NAV_SPEED",

@@ -6,7 +6,7 @@ import pytest
 
 from frontseat.protobuf.frontseat_pb2 import HELM_DRIVE, HELM_NOT_RUNNING, HELM_PARK
 from gateway.moos.message import NOTIFY, MoosMessage
-from translators.helm_conversion import SetpointError, desired_course, helm_state
+from translators.frontseat.helm_conversion import SetpointError, desired_course, helm_state
 
 
 def number(key: str, value: float, t: float = 100.0) -> MoosMessage:

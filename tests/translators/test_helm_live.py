@@ -18,8 +18,8 @@ from translator_procs import ORIGIN, ChildProcess, run_cli
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import USV, DesiredCourse, NodeStatus
 from frontseat.protobuf.frontseat_pb2 import HELM_DRIVE, HelmStateReport
+from gateway.goby.portal.testing import PortalClient
 from gateway.moos.testing import connected_comms
-from gateway.portal.testing import PortalClient
 
 TIMEOUT_S = 60.0
 WAYPOINT_SPEED = 1.0
@@ -75,7 +75,7 @@ def helm_command(kind: str, mission: Path) -> list[str]:
         if shutil.which("pHelmIvP") is None:
             pytest.skip("the real pHelmIvP is not on PATH")
         return ["pHelmIvP", str(mission)]
-    run_main = "import sys; from behaviors.helm.app import main; sys.exit(main())"  # the ivp-helm console script
+    run_main = "import sys; from behaviors.apps.ivp_helm import main; sys.exit(main())"  # the ivp-helm console script
     return [sys.executable, "-c", run_main, str(mission), "-v"]
 
 

@@ -9,8 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus, Source
-from gateway.geodesy import UTMGeodesy
-from translators.nav_conversion import format_g15, format_report_number, nav_posts, node_report
+from translators.frontseat.nav_conversion import format_g15, format_report_number, nav_posts, node_report
+from util.geodesy import UTMGeodesy
 
 # ivp_helm.md §7.3: origin 43.8253, -70.3304 (zone 19T); (x, y) <-> (lat, lon) from pyproj/PROJ and a Gantz port.
 ORIGIN = (43.8253, -70.3304)

@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import importlib
-import importlib.resources
 import math
-import sys
 from pathlib import Path
 
 import pytest
 
+from tests.protobuf import basic_node_report_pb2
 from translators import techniques
 from translators.techniques import Technique, TechniqueError
 
@@ -20,21 +18,9 @@ PREFIX = "@PB[goby.test.moos.protobuf.BasicNodeReport] "
 
 
 @pytest.fixture(scope="module")
-def pb(tmp_path_factory: pytest.TempPathFactory):
-    """The test-only protos, compiled with grpc_tools' protoc into a temp dir and imported."""
-    from grpc_tools import protoc
-
-    out = tmp_path_factory.mktemp("protos")
-    well_known = importlib.resources.files("grpc_tools") / "_proto"
-    args = ["protoc", f"-I{HERE}", f"-I{well_known}", f"--python_out={out}", str(HERE / "basic_node_report.proto")]
-    assert protoc.main(args) == 0
-    if "basic_node_report_pb2" not in sys.modules:
-        sys.path.insert(0, str(out))
-        try:
-            importlib.import_module("basic_node_report_pb2")
-        finally:
-            sys.path.remove(str(out))
-    return sys.modules["basic_node_report_pb2"]
+def pb():
+    """The test-only protos (committed generated code, tests/protobuf)."""
+    return basic_node_report_pb2
 
 
 @pytest.fixture

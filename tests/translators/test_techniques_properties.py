@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
-import importlib
-import importlib.resources
-import sys
 from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.protobuf import basic_node_report_pb2
 from translators import techniques
 from translators.techniques import Technique
 from translators.techniques.numbers import simple_dtoa, simple_ftoa
@@ -18,24 +16,9 @@ from translators.techniques.numbers import simple_dtoa, simple_ftoa
 HERE = Path(__file__).resolve().parent
 
 
-def _load_test_protos(out: Path):
-    from grpc_tools import protoc
-
-    if "basic_node_report_pb2" not in sys.modules:
-        well_known = importlib.resources.files("grpc_tools") / "_proto"
-        assert protoc.main(["protoc", f"-I{HERE}", f"-I{well_known}", f"--python_out={out}",
-                            str(HERE / "basic_node_report.proto")]) == 0
-        sys.path.insert(0, str(out))
-        try:
-            importlib.import_module("basic_node_report_pb2")
-        finally:
-            sys.path.remove(str(out))
-    return sys.modules["basic_node_report_pb2"]
-
-
 @pytest.fixture(scope="module")
-def pb(tmp_path_factory):
-    return _load_test_protos(tmp_path_factory.mktemp("protos"))
+def pb():
+    return basic_node_report_pb2
 
 
 finite = st.floats(allow_nan=False)

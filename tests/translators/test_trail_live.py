@@ -11,11 +11,11 @@ from translator_procs import ORIGIN, ChildProcess
 
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import USV, NodeStatus
-from gateway.geodesy import UTMGeodesy
+from gateway.goby.portal.testing import PortalClient, broker_process
 from gateway.moos.testing import connected_comms, running_moosdb
-from gateway.portal.testing import PortalClient, broker_process
 from translators.node_report import NodeReportTranslation
 from translators.testing import gateway_config, hosted_translators
+from util.geodesy import UTMGeodesy
 
 TIMEOUT_S = 60.0
 

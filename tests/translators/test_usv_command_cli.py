@@ -7,14 +7,14 @@ import sys
 import pytest
 from translator_procs import ChildProcess, run_cli, wait_until
 
-from gateway.portal.testing import PortalClient, broker_process
-from translators.usv import groups as usv_groups
-from translators.usv.command_cli import (
+from gateway.goby.portal.testing import PortalClient, broker_process
+from translators.apps.usv_command import (
     EXIT_UNACKNOWLEDGED,
     build_command,
     build_parser,
     describe_ack,
 )
+from translators.usv import groups as usv_groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 
@@ -54,7 +54,7 @@ def test_describe_ack():
 def test_without_a_translator_the_command_is_not_acknowledged(tmp_path):
     """usv-manager answers but no gateway does: the CLI reports it and exits 3 after its timeout."""
     with broker_process(tmp_path, platform="shore") as broker:
-        manager = ChildProcess("usv_manager", [sys.executable, "-m", "translators.usv.manager", "-v"], tmp_path,
+        manager = ChildProcess("usv_manager", [sys.executable, "-m", "translators.apps.usv_manager", "-v"], tmp_path,
                                broker.env())
         try:
             with PortalClient(broker.interprocess_config(), name="probe") as client:
@@ -78,7 +78,7 @@ def test_bad_goby_option_is_a_configuration_error(tmp_path):
 
 
 def test_example_config_needs_no_command(capsys):
-    from translators.usv.command_cli import main
+    from translators.apps.usv_command import main
 
     assert main(["--example_config"]) == 0
     out = capsys.readouterr().out

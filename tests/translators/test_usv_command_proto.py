@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gateway.protobuf.include.dccl import option_extensions_pb2 as dccl_options
+from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as dccl_options
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from translators.usv.validation import DcclBoundsError, check_dccl_bounds, dccl_message_options, field_bounds
 
@@ -111,7 +111,7 @@ def test_the_course_proto_compiles_unchanged_with_protoc(tmp_path, source):
     result = subprocess.run(
         [
             sys.executable, "-m", "grpc_tools.protoc",
-            f"-I{REPO / 'gateway' / 'protobuf' / 'include'}", f"-I{tmp_path}",
+            f"-I{REPO / 'gateway' / 'goby' / 'protobuf' / 'include'}", f"-I{tmp_path}",
             f"-I{Path(grpc_tools.__file__).parent / '_proto'}",
             f"--descriptor_set_out={tmp_path / 'set.pb'}", str(course_copy),
         ],

@@ -67,7 +67,7 @@ def moosdb(kind: str, workdir: Path, community: str = "usv") -> Iterator[int]:
 
 
 def gateway_args(moos_port: int, origin: tuple[float, float] | None = ORIGIN) -> list[str]:
-    args = [sys.executable, "-m", "gateway.moos_gateway", "--moos", f'server: "127.0.0.1" port: {moos_port}', "-vv"]
+    args = [sys.executable, "-m", "gateway.moos_gateway.app", "--moos", f'server: "127.0.0.1" port: {moos_port}', "-vv"]
     if origin is not None:
         args += ["--app", f"geodesy {{ lat_origin: {origin[0]} lon_origin: {origin[1]} }}"]
     return args
@@ -91,7 +91,7 @@ def plugin_env(broker_env: dict[str, str], plugins: str) -> dict[str, str]:
 
 def run_cli(args: list[str], env: dict[str, str], workdir: Path, timeout_s: float = 60.0) -> subprocess.CompletedProcess:
     """``usv-command`` with ``args``, to completion."""
-    return subprocess.run([sys.executable, "-m", "translators.usv.command_cli", *args], env=env, cwd=workdir,
+    return subprocess.run([sys.executable, "-m", "translators.apps.usv_command", *args], env=env, cwd=workdir,
                           capture_output=True, text=True, timeout=timeout_s)
 
 

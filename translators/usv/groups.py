@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from gateway.portal.group import Group
+from gateway.goby.portal.group import Group
 
 # On the vehicle: usv-manager republishes here; CommandTranslation subscribes (the course's usv_command, 0).
 usv_command = Group("goby3_course::usv_command", 0)

@@ -15,7 +15,7 @@ from typing import TypeVar
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
-from gateway.protobuf.include.dccl import option_extensions_pb2 as dccl_options
+from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as dccl_options
 
 _DEFAULT_CODECS = {"dccl.default2", "dccl.default3", "dccl.default4"}
 _NUMERIC_TYPES = {

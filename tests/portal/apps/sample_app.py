@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import sys
 
-from gateway.portal import MultiThreadApplication, SimpleThread, SingleThreadApplication, run_application
-from gateway.portal.protobuf.test_messages_pb2 import Sample, SampleAppConfig
+from gateway.goby.portal import MultiThreadApplication, SimpleThread, SingleThreadApplication, run_application
+from tests.protobuf.sample_messages_pb2 import Sample, SampleAppConfig
 
 
 class TxApp(SingleThreadApplication):

@@ -22,7 +22,7 @@ _runtime_version.ValidateProtobufRuntimeVersion(
 _sym_db = _symbol_database.Default()
 
 
-from gateway.protobuf.include.dccl import option_extensions_pb2 as dccl_dot_option__extensions__pb2
+from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as dccl_dot_option__extensions__pb2
 
 
 DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n+translators/usv/protobuf/command_dccl.proto\x12\x11goby3_course.dccl\x1a\x1c\x64\x63\x63l/option_extensions.proto\"\x9d\x02\n\nUSVCommand\x12&\n\x04time\x18\x01 \x02(\x01\x42\x18\xa2?\x15\n\ndccl.time2\xf2\x01\x06\x12\x04time\x12\x42\n\rdesired_state\x18\x02 \x02(\x0e\x32+.goby3_course.dccl.USVCommand.AutonomyState\x12,\n\rpolygon_sides\x18\x03 \x01(\x05\x42\x15\xa2?\x12\x31\x00\x00\x00\x00\x00\x00\x08@9\x00\x00\x00\x00\x00\x00$@\x12\x38\n\x0epolygon_radius\x18\x04 \x01(\x05\x42 \xa2?\x1d \xff\xff\xff\xff\xff\xff\xff\xff\xff\x01\x31\x00\x00\x00\x00\x00\x00Y@9\x00\x00\x00\x00\x00@\x9f@\"+\n\rAutonomyState\x12\r\n\tWAYPOINTS\x10\x01\x12\x0b\n\x07POLYGON\x10\x02:\x0e\xa2?\x0b\x08~\x10 (\x03\xf2\x01\x02si')

@@ -1,4 +1,4 @@
-from gateway.protobuf.include.dccl import option_extensions_pb2 as _option_extensions_pb2
+from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as _option_extensions_pb2
 from google.protobuf.internal import enum_type_wrapper as _enum_type_wrapper
 from google.protobuf import descriptor as _descriptor
 from google.protobuf import message as _message

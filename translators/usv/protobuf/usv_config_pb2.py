@@ -22,19 +22,19 @@ _runtime_version.ValidateProtobufRuntimeVersion(
 _sym_db = _symbol_database.Default()
 
 
-from gateway.protobuf import app_config_pb2 as gateway_dot_protobuf_dot_app__config__pb2
-from gateway.protobuf import interprocess_config_pb2 as gateway_dot_protobuf_dot_interprocess__config__pb2
+from gateway.goby.protobuf import app_config_pb2 as gateway_dot_goby_dot_protobuf_dot_app__config__pb2
+from gateway.goby.protobuf import interprocess_config_pb2 as gateway_dot_goby_dot_protobuf_dot_interprocess__config__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n)translators/usv/protobuf/usv_config.proto\x12\x13goby3_course.config\x1a!gateway/protobuf/app_config.proto\x1a*gateway/protobuf/interprocess_config.proto\"\xae\x01\n\nUSVManager\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x12\n\nvehicle_id\x18\x0b \x01(\x05\x12\x14\n\x0c\x61uv_modem_id\x18\x14 \x03(\x05\"\x9e\x01\n\x0b\x43ommandTool\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x17\n\x0b\x61\x63k_timeout\x18\n \x01(\x01:\x02\x31\x30')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n)translators/usv/protobuf/usv_config.proto\x12\x13goby3_course.config\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\"\xae\x01\n\nUSVManager\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x12\n\nvehicle_id\x18\x0b \x01(\x05\x12\x14\n\x0c\x61uv_modem_id\x18\x14 \x03(\x05\"\x9e\x01\n\x0b\x43ommandTool\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x17\n\x0b\x61\x63k_timeout\x18\n \x01(\x01:\x02\x31\x30')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'translators.usv.protobuf.usv_config_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_USVMANAGER']._serialized_start=146
-  _globals['_USVMANAGER']._serialized_end=320
-  _globals['_COMMANDTOOL']._serialized_start=323
-  _globals['_COMMANDTOOL']._serialized_end=481
+  _globals['_USVMANAGER']._serialized_start=156
+  _globals['_USVMANAGER']._serialized_end=330
+  _globals['_COMMANDTOOL']._serialized_start=333
+  _globals['_COMMANDTOOL']._serialized_end=491
 # @@protoc_insertion_point(module_scope)

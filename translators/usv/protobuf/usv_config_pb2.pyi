@@ -1,5 +1,5 @@
-from gateway.protobuf import app_config_pb2 as _app_config_pb2
-from gateway.protobuf import interprocess_config_pb2 as _interprocess_config_pb2
+from gateway.goby.protobuf import app_config_pb2 as _app_config_pb2
+from gateway.goby.protobuf import interprocess_config_pb2 as _interprocess_config_pb2
 from google.protobuf.internal import containers as _containers
 from google.protobuf import descriptor as _descriptor
 from google.protobuf import message as _message

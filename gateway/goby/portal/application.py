@@ -1,0 +1,136 @@
+"""Applications in Goby's shape: the main thread is itself a :class:`SimpleThread`; a multi-thread application
+launches and joins further threads, each running its own poll loop on its own Python thread."""
+
+from __future__ import annotations
+
+import logging
+import threading
+from typing import Any
+
+from gateway.goby.portal.context import use_context
+from gateway.goby.portal.errors import ThreadError
+from gateway.goby.portal.thread import SimpleThread, interprocess_config_of
+
+log = logging.getLogger(__name__)
+
+
+class _Application(SimpleThread):
+    """Common base: return code, ``quit(code)``, eager portal (so the main thread runs the hold handshake)."""
+
+    def __init__(self, cfg: Any, loop_frequency_hz: float = 0.0) -> None:
+        descriptor = getattr(cfg, "DESCRIPTOR", None)
+        if descriptor is not None and "app" in descriptor.fields_by_name and cfg.app.HasField("loop_frequency"):
+            loop_frequency_hz = cfg.app.loop_frequency  # app.loop_frequency overrides the compiled-in value
+        super().__init__(cfg, loop_frequency_hz)
+        self._return_code = 0
+        if interprocess_config_of(cfg) is not None:
+            self.interprocess()
+
+    @property
+    def return_code(self) -> int:
+        return self._return_code
+
+    def quit(self, code: int = 0) -> None:  # type: ignore[override]
+        """Stop the application with exit ``code`` (thread-safe; the first non-zero code wins)."""
+        if code and not self._return_code:
+            self._return_code = code
+        super().quit()
+
+    def app_name(self) -> str:
+        return self.context.application
+
+    def _after_initialize(self) -> None:
+        if self._transports.has_interprocess:
+            self.interprocess().ready()
+
+
+class SingleThreadApplication(_Application):
+    """One thread: subscriptions, ``loop()`` and ``call_soon`` work all run on the main thread."""
+
+
+class MultiThreadApplication(_Application):
+    """The main thread plus threads started with :meth:`launch_thread`."""
+
+    def __init__(self, cfg: Any, loop_frequency_hz: float = 0.0) -> None:
+        super().__init__(cfg, loop_frequency_hz)
+        self._threads: list[tuple[SimpleThread, threading.Thread]] = []
+        self._threads_lock = threading.Lock()
+
+    def launch_thread(self, thread_class: type[SimpleThread], *args: Any, **kwargs: Any) -> SimpleThread:
+        """Start ``thread_class(*args, **kwargs)`` (default args: ``(self.cfg(),)``) on a new Python thread.
+
+        The instance is constructed on the new thread (so its subscriptions and sockets belong there); this call
+        returns once construction finished, and raises ``ThreadError`` if the constructor raised.  If the
+        thread's ``loop()`` later raises, the error is logged and the application quits with code 1.
+        """
+        if not args and not kwargs:
+            args = (self.cfg(),)
+        constructed = threading.Event()
+        box: dict[str, Any] = {}
+
+        def target() -> None:
+            with use_context(self.context):
+                try:
+                    instance = thread_class(*args, **kwargs)
+                except BaseException as exc:  # noqa: BLE001 - reported to the launcher
+                    box["error"] = exc
+                    constructed.set()
+                    return
+                box["thread"] = instance
+                constructed.set()
+                try:
+                    instance.run()
+                except Exception:
+                    log.exception("thread %s failed; quitting the application", thread_class.__qualname__)
+                    self.quit(1)
+                finally:
+                    instance.close()
+
+        pythread = threading.Thread(target=target, name=thread_class.__qualname__)
+        pythread.start()
+        constructed.wait()
+        if "error" in box:
+            pythread.join()
+            raise ThreadError(f"{thread_class.__qualname__} failed to start: {box['error']}") from box["error"]
+        instance: SimpleThread = box["thread"]
+        with self._threads_lock:
+            self._threads.append((instance, pythread))
+        log.debug("launched thread %s", thread_class.__qualname__)
+        return instance
+
+    def join_thread(self, which: type[SimpleThread] | SimpleThread, timeout: float | None = None) -> int:
+        """Stop and join the launched threads of a class (or one instance); returns how many have ended.
+
+        A thread that does not end within ``timeout`` is logged and stays listed, so ``close()`` joins it again.
+        """
+        with self._threads_lock:
+            chosen = [
+                (inst, t) for inst, t in self._threads
+                if inst is which or (isinstance(which, type) and type(inst) is which)
+            ]
+        for inst, _ in chosen:
+            inst.quit()
+        joined = []
+        for inst, pythread in chosen:
+            pythread.join(timeout)
+            if pythread.is_alive():
+                # Keep it listed, so close() tries again rather than forgetting a live thread.
+                log.error("thread %s did not stop within %s s", type(inst).__qualname__, timeout)
+            else:
+                joined.append((inst, pythread))
+        with self._threads_lock:
+            self._threads = [pair for pair in self._threads if pair not in joined]
+        return len(joined)
+
+    def threads(self) -> list[SimpleThread]:
+        """The launched threads still running (not yet joined)."""
+        with self._threads_lock:
+            return [inst for inst, _ in self._threads]
+
+    def close(self) -> None:
+        """Join every launched thread, then close the main thread's transports; idempotent."""
+        with self._threads_lock:
+            remaining = list(self._threads)
+        for inst, _ in remaining:
+            self.join_thread(inst)
+        super().close()

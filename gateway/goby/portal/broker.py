@@ -1,0 +1,299 @@
+"""The broker (gobyd's router and manager): an XPUB/XSUB proxy plus the manager that hands out endpoints and
+runs the start-up hold.
+
+Two threads: the proxy (``zmq.proxy_steerable``, stopped through an inproc control socket) and the manager
+(REP for endpoint requests, SUB/PUB on the proxy for hold-state requests).  Neither thread runs user code.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import socket
+import threading
+
+import zmq
+
+from gateway.goby.portal.endpoints import (
+    MANAGER_REQUEST_GROUP,
+    MANAGER_RESPONSE_GROUP,
+    ipc_base,
+    manager_endpoint,
+)
+from gateway.goby.portal.errors import ClosedError, IdentifierError, PortalError
+from gateway.goby.portal.identifier import decode_frame, encode_frame, make_identifier, thread_id, type_prefix
+from gateway.goby.portal.marshalling import Scheme
+from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
+from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from gateway.goby.protobuf.interprocess_zeromq_pb2 import (
+    PROVIDE_HOLD_STATE,
+    PROVIDE_PUB_SUB_SOCKETS,
+    ManagerRequest,
+    ManagerResponse,
+    Socket,
+)
+
+log = logging.getLogger(__name__)
+
+
+class BrokerError(PortalError):
+    """The broker cannot start (e.g. another broker already serves the platform)."""
+
+
+def _ipc_in_use(path: str) -> bool:
+    """True when something accepts connections on the Unix socket ``path`` (a live broker)."""
+    if not os.path.exists(path):
+        return False
+    probe = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    probe.settimeout(0.5)
+    try:
+        probe.connect(path)
+        return True
+    except OSError:
+        return False
+    finally:
+        probe.close()
+
+
+class Broker:
+    """Router + manager for one platform.  ``start()`` binds and returns when ready; ``stop()`` is idempotent."""
+
+    def __init__(self, cfg: GobyDaemonConfig | None = None) -> None:
+        self.cfg = cfg if cfg is not None else GobyDaemonConfig()
+        self.ipc: InterProcessPortalConfig = self.cfg.interprocess
+        self.required_clients = frozenset(self.cfg.hold.required_client)
+        self.reported_clients: set[str] = set()
+        self.pub_port = 0  # TCP: the XPUB (clients' subscribe socket) port
+        self.sub_port = 0  # TCP: the XSUB (clients' publish socket) port
+        self.manager_port = 0
+        self._zctx: zmq.Context | None = None
+        self._mctx: zmq.Context | None = None
+        self._threads: list[threading.Thread] = []
+        self._proxy_control: zmq.Socket | None = None
+        self._manager_stop: zmq.Socket | None = None
+        self._started = False
+        self._stopped = False
+        self._ipc_files: list[str] = []  # created by this broker, removed on stop
+        self._ready = threading.Event()
+        self._errors: list[BaseException] = []
+
+    @property
+    def is_tcp(self) -> bool:
+        return self.ipc.transport == InterProcessPortalConfig.TCP
+
+    def endpoints(self) -> dict[str, str]:
+        """Bound endpoints: ``xpub``, ``xsub``, ``manager``."""
+        if self.is_tcp:
+            host = "127.0.0.1"
+            return {"xpub": f"tcp://{host}:{self.pub_port}", "xsub": f"tcp://{host}:{self.sub_port}",
+                    "manager": f"tcp://{host}:{self.manager_port}"}
+        base = ipc_base(self.ipc)
+        return {"xpub": f"ipc://{base}.xpub", "xsub": f"ipc://{base}.xsub", "manager": f"ipc://{base}.manager"}
+
+    # ------------------------------------------------------------------------------------------ lifecycle
+    def start(self) -> Broker:
+        """Bind every socket and start the threads; raises ``BrokerError`` if the platform is taken."""
+        if self._stopped:
+            raise ClosedError("broker was stopped; create a new one")
+        if self._started:
+            return self
+        if not self.is_tcp and _ipc_in_use(ipc_base(self.ipc) + ".manager"):
+            raise BrokerError(f"another broker already serves {ipc_base(self.ipc)}.manager "
+                              f"(platform {self.ipc.platform!r})")
+        self._started = True
+        self._zctx = zmq.Context(io_threads=max(1, self.cfg.router_threads))
+        self._mctx = zmq.Context(io_threads=1)
+        xpub = self._zctx.socket(zmq.XPUB)
+        xsub = self._zctx.socket(zmq.XSUB)
+        for sock in (xpub, xsub):
+            sock.setsockopt(zmq.SNDHWM, self.ipc.send_queue_size)
+            sock.setsockopt(zmq.RCVHWM, self.ipc.receive_queue_size)
+            sock.setsockopt(zmq.IPV6, 1)
+            sock.setsockopt(zmq.LINGER, 0)
+        try:
+            if self.is_tcp:
+                self.pub_port = xpub.bind_to_random_port("tcp://*")
+                self.sub_port = xsub.bind_to_random_port("tcp://*")
+            else:
+                base = ipc_base(self.ipc)
+                xpub.bind(f"ipc://{base}.xpub")
+                self._ipc_files.append(f"{base}.xpub")
+                xsub.bind(f"ipc://{base}.xsub")
+                self._ipc_files.append(f"{base}.xsub")
+        except zmq.ZMQError as exc:
+            xpub.close()
+            xsub.close()
+            self.stop()
+            raise BrokerError(f"cannot bind the broker's pub/sub sockets: {exc}") from exc
+        control_addr = f"inproc://broker-control-{id(self)}"
+        control_peer = self._zctx.socket(zmq.PAIR)
+        control_peer.bind(control_addr)
+        self._proxy_control = self._zctx.socket(zmq.PAIR)
+        self._proxy_control.connect(control_addr)
+        proxy = threading.Thread(target=self._run_proxy, args=(xpub, xsub, control_peer), name="broker-proxy")
+        proxy.start()
+        self._threads.append(proxy)
+
+        rep = self._mctx.socket(zmq.REP)
+        rep.setsockopt(zmq.LINGER, 0)
+        rep.setsockopt(zmq.IPV6, 1)
+        try:
+            endpoint = manager_endpoint(self.ipc, bind=True)
+            if self.is_tcp and self.ipc.tcp_port == 0:
+                self.manager_port = rep.bind_to_random_port("tcp://*")
+            else:
+                rep.bind(endpoint)
+                self.manager_port = self.ipc.tcp_port if self.is_tcp else 0
+                if not self.is_tcp:
+                    self._ipc_files.append(f"{ipc_base(self.ipc)}.manager")
+        except zmq.ZMQError as exc:
+            rep.close()
+            self.stop()
+            raise BrokerError(f"cannot bind the manager socket {manager_endpoint(self.ipc, True)}: {exc}") from exc
+        stop_addr = f"inproc://broker-manager-stop-{id(self)}"
+        stop_peer = self._mctx.socket(zmq.PAIR)
+        stop_peer.bind(stop_addr)
+        self._manager_stop = self._mctx.socket(zmq.PAIR)
+        self._manager_stop.connect(stop_addr)
+        manager = threading.Thread(target=self._run_manager, args=(rep, stop_peer), name="broker-manager")
+        manager.start()
+        self._threads.append(manager)
+        if not self._ready.wait(10):
+            self.stop()
+            raise BrokerError("the broker's manager thread did not become ready within 10 s")
+        log.info("broker ready for platform %r: %s", self.ipc.platform, self.endpoints())
+        return self
+
+    def stop(self) -> None:
+        """Stop both threads and close every socket; idempotent."""
+        if self._stopped:
+            return
+        self._stopped = True
+        if self._proxy_control is not None:
+            self._proxy_control.send(b"TERMINATE")
+        if self._manager_stop is not None:
+            self._manager_stop.send(b"STOP")
+        for thread in self._threads:
+            thread.join(10)
+        for sock in (self._proxy_control, self._manager_stop):
+            if sock is not None:
+                sock.close(linger=0)
+        for zctx in (self._zctx, self._mctx):
+            if zctx is not None:
+                zctx.term()
+        for path in self._ipc_files:
+            try:
+                os.unlink(path)
+            except OSError:
+                pass
+        log.info("broker stopped")
+
+    def __enter__(self) -> Broker:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    # -------------------------------------------------------------------------------------------- threads
+    def _run_proxy(self, xpub: zmq.Socket, xsub: zmq.Socket, control: zmq.Socket) -> None:
+        try:
+            zmq.proxy_steerable(xpub, xsub, None, control)
+        except zmq.ContextTerminated:
+            pass
+        except zmq.ZMQError as exc:
+            log.error("broker proxy stopped: %s", exc)
+        finally:
+            for sock in (xpub, xsub, control):
+                sock.close(linger=0)
+
+    def _run_manager(self, rep: zmq.Socket, stop: zmq.Socket) -> None:
+        endpoints = self.endpoints()
+        sub = self._mctx.socket(zmq.SUB)
+        pub = self._mctx.socket(zmq.PUB)
+        for sock in (sub, pub):
+            sock.setsockopt(zmq.LINGER, 0)
+        sub.connect(endpoints["xpub"])
+        pub.connect(endpoints["xsub"])
+        sub.setsockopt(zmq.SUBSCRIBE, type_prefix(
+            MANAGER_REQUEST_GROUP, Scheme.PROTOBUF, ManagerRequest.DESCRIPTOR.full_name).encode())
+        response_ident = make_identifier(
+            MANAGER_RESPONSE_GROUP, Scheme.PROTOBUF, ManagerResponse.DESCRIPTOR.full_name, os.getpid(), thread_id())
+        poller = zmq.Poller()
+        for sock in (rep, sub, stop):
+            poller.register(sock, zmq.POLLIN)
+        self._ready.set()
+        try:
+            while True:
+                ready = dict(poller.poll())
+                if stop in ready:
+                    return
+                if rep in ready:
+                    rep.send(self._answer_rep(rep.recv()))
+                if sub in ready:
+                    reply = self._answer_hold(sub.recv())
+                    if reply is not None:
+                        pub.send(encode_frame(response_ident, reply.SerializeToString()))
+        except zmq.ContextTerminated:
+            pass
+        finally:
+            for sock in (rep, sub, pub, stop):
+                sock.close(linger=0)
+
+    # ------------------------------------------------------------------------------------------ answers
+    def _answer_rep(self, raw: bytes) -> bytes:
+        """Answer one REQ; a malformed request is logged and gets an empty reply (REP must always answer)."""
+        request = ManagerRequest()
+        try:
+            request.ParseFromString(raw)
+            if not request.IsInitialized():
+                raise ValueError("missing " + ", ".join(request.FindInitializationErrors()))
+        except Exception as exc:  # noqa: BLE001 - any decode failure
+            log.error("manager: malformed ManagerRequest (%d bytes): %s", len(raw), exc)
+            return b""
+        response = self.respond(request)
+        return response.SerializeToString() if response is not None else b""
+
+    def _answer_hold(self, frame: bytes) -> ManagerResponse | None:
+        try:
+            _, payload = decode_frame(frame)
+            request = ManagerRequest.FromString(payload)
+            if not request.IsInitialized():
+                raise ValueError("missing " + ", ".join(request.FindInitializationErrors()))
+        except (IdentifierError, Exception) as exc:  # noqa: BLE001
+            log.error("manager: malformed hold request: %s", exc)
+            return None
+        return self.respond(request)
+
+    def respond(self, request: ManagerRequest) -> ManagerResponse | None:
+        """The manager's answer to one request (pure; exposed for tests)."""
+        response = ManagerResponse(
+            request=request.request, client_name=request.client_name, client_pid=request.client_pid
+        )
+        if request.request == PROVIDE_PUB_SUB_SOCKETS:
+            log.debug("manager: sockets for %s (pid %d)", request.client_name, request.client_pid)
+            response.publish_socket.CopyFrom(self._socket(Socket.PUBLISH))
+            response.subscribe_socket.CopyFrom(self._socket(Socket.SUBSCRIBE))
+            return response
+        if request.request == PROVIDE_HOLD_STATE:
+            if request.ready and request.client_name in self.required_clients:
+                if request.client_name not in self.reported_clients:
+                    log.info("manager: required client %s is ready", request.client_name)
+                self.reported_clients.add(request.client_name)
+            response.hold = self.reported_clients != set(self.required_clients)
+            return response
+        log.error("manager: unknown request %d from %s", request.request, request.client_name)
+        return None
+
+    def _socket(self, socket_type: int) -> Socket:
+        sock = Socket(
+            socket_type=socket_type, connect_or_bind=Socket.CONNECT,
+            send_queue_size=self.ipc.send_queue_size, receive_queue_size=self.ipc.receive_queue_size,
+        )
+        if self.is_tcp:
+            sock.transport = Socket.TCP
+            sock.ethernet_port = self.sub_port if socket_type == Socket.PUBLISH else self.pub_port
+        else:
+            sock.transport = Socket.IPC
+            suffix = ".xsub" if socket_type == Socket.PUBLISH else ".xpub"
+            sock.socket_name = ipc_base(self.ipc) + suffix
+        return sock

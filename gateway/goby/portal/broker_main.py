@@ -1,0 +1,62 @@
+"""``goby-broker``: run the broker for one platform (the gobyd role) until SIGINT/SIGTERM.
+
+Config: ``GobyDaemonConfig`` in protobuf text format (``app {}``, ``router_threads``, ``interprocess {}``,
+``hold { required_client: ... }``), command-line overrides such as ``--interprocess 'platform: "usv"'``, and
+``GOBY_INTERPROCESS``.  Prints one line ``goby-broker ready: {...}`` (JSON endpoints) to stdout when serving.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import signal
+import sys
+import threading
+
+from gateway.goby.portal.broker import Broker, BrokerError
+from gateway.goby.portal.config import load_for_run
+from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
+from util.logsetup import configure_logging
+
+log = logging.getLogger(__name__)
+
+READY_PREFIX = "goby-broker ready: "
+
+
+def main(argv: list[str] | None = None) -> int:
+    loaded = load_for_run(GobyDaemonConfig, argv, "goby-broker")
+    if isinstance(loaded, int):
+        return loaded
+    cfg = loaded.cfg
+    configure_logging(loaded.verbosity, cfg.app.name)
+    if not cfg.interprocess.HasField("platform"):
+        log.warning("Using default platform name of %s", cfg.interprocess.platform)
+    stop = threading.Event()
+
+    def on_signal(signum: int, _frame: object) -> None:
+        log.info("received %s; stopping", signal.Signals(signum).name)
+        stop.set()
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    broker = Broker(cfg)
+    try:
+        try:
+            broker.start()
+        except BrokerError as exc:
+            log.critical("%s", exc)
+            return 1
+        info = {"platform": cfg.interprocess.platform, **broker.endpoints(), "pid": os.getpid()}
+        print(READY_PREFIX + json.dumps(info), flush=True)
+        log.info("=== goby-broker is ready ===")
+        while not stop.wait(1.0):
+            pass
+        return 0
+    finally:
+        broker.stop()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

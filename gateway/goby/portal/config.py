@@ -1,0 +1,241 @@
+"""Application configuration: protobuf text-format files, command-line overrides, ``GOBY_INTERPROCESS``, and the
+commented ``--example_config`` text.
+
+Precedence: command-line overrides > config file > ``GOBY_INTERPROCESS`` (used only when neither the file nor
+the command line set the ``interprocess`` block), as Goby's configurator does.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from google.protobuf import descriptor as pb_descriptor
+from google.protobuf import message as pb_message
+from google.protobuf import text_format
+
+from gateway.goby.portal.errors import ConfigError
+from util.logsetup import add_verbosity_argument
+
+INTERPROCESS_ENV = "GOBY_INTERPROCESS"
+_FD = pb_descriptor.FieldDescriptor
+
+# app.glog_config.tty_verbosity -> our -v count
+_TTY_VERBOSITY = {1: 0, 2: 0, 4: 1, 5: 2, 6: 3, 7: 3}
+
+
+@dataclass
+class LoadedConfig:
+    """The result of :func:`load_config`."""
+
+    cfg: pb_message.Message
+    verbosity: int
+    example_requested: bool
+    debug_cfg: bool
+
+
+def _merge_text(target: pb_message.Message, text: str, where: str) -> None:
+    try:
+        text_format.Merge(text, target)
+    except text_format.ParseError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+
+
+def _scalar_override(field: pb_descriptor.FieldDescriptor, value: str) -> str:
+    """Text-format for ``--field value`` of a scalar field: strings are quoted unless already quoted."""
+    if field.type in (_FD.TYPE_STRING, _FD.TYPE_BYTES) and not (value.startswith('"') or value.startswith("'")):
+        value = '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return f"{field.name}: {value}"
+
+
+def build_parser(config_type: type[pb_message.Message], prog: str | None = None) -> argparse.ArgumentParser:
+    """Goby-style command line: a config file, ``--<top-level field> VALUE`` overrides, ``-e``, ``-v``."""
+    parser = argparse.ArgumentParser(
+        prog=prog,
+        description=f"Configuration: {config_type.DESCRIPTOR.full_name} in protobuf text format.",
+        epilog="Message fields take text format (e.g. --interprocess 'platform: \"usv\"'); repeat an option to add "
+        "to a repeated field.",
+    )
+    parser.add_argument("config_file", nargs="?", help="configuration file (protobuf text format)")
+    parser.add_argument("-c", "--cfg_path", help="configuration file (alternative to the positional argument)")
+    parser.add_argument("-e", "--example_config", action="store_true", help="print a commented example and exit")
+    parser.add_argument("-a", "--app_name", help="set app.name")
+    parser.add_argument("-n", "--ncurses", action="store_true",
+                        help="accepted for compatibility with Goby command lines; there is no ncurses GUI (ignored)")
+    add_verbosity_argument(parser)
+    for field in config_type.DESCRIPTOR.fields:
+        kind = "message (text format)" if field.type == _FD.TYPE_MESSAGE else _type_label(field)
+        try:
+            parser.add_argument(f"--{field.name}", action="append", metavar="VALUE", dest=f"field_{field.name}",
+                                help=f"override {field.name}: {kind}")
+        except argparse.ArgumentError:
+            pass  # a field named like a common option (e.g. "verbose"): set it in the file or a message block
+    return parser
+
+
+def load_config(
+    config_type: type[pb_message.Message], argv: list[str] | None = None, prog: str | None = None,
+    environ: dict[str, str] | None = None,
+) -> LoadedConfig:
+    """Parse ``argv`` into a ``config_type`` message; ``ConfigError`` names the file/option that is wrong."""
+    environ = os.environ if environ is None else environ
+    parser = build_parser(config_type, prog)
+    args = parser.parse_args(argv)
+    cfg = config_type()
+    if args.example_config:
+        return LoadedConfig(cfg, args.verbose, True, False)
+    path = args.cfg_path or args.config_file
+    if path:
+        try:
+            text = Path(path).read_text()
+        except OSError as exc:
+            raise ConfigError(f"cannot read configuration file {path}: {exc.strerror}") from None
+        _merge_text(cfg, text, f"configuration file {path}")
+    for field in config_type.DESCRIPTOR.fields:
+        for value in getattr(args, f"field_{field.name}", None) or ():
+            if field.type == _FD.TYPE_MESSAGE:
+                target = getattr(cfg, field.name).add() if _is_repeated(field) else getattr(cfg, field.name)
+                _merge_text(target, value, f"--{field.name}")
+                if not _is_repeated(field):
+                    getattr(cfg, field.name).SetInParent()
+            else:
+                _merge_text(cfg, _scalar_override(field, value), f"--{field.name}")
+    fields = config_type.DESCRIPTOR.fields_by_name
+    if "interprocess" in fields and not cfg.HasField("interprocess") and environ.get(INTERPROCESS_ENV):
+        _merge_text(cfg.interprocess, environ[INTERPROCESS_ENV], f"${INTERPROCESS_ENV}")
+        cfg.interprocess.SetInParent()
+    if "app" in fields:
+        if args.app_name:
+            cfg.app.name = args.app_name
+        if not cfg.app.HasField("name"):
+            cfg.app.name = prog or os.path.basename(sys.argv[0] or "app")
+    if not cfg.IsInitialized():
+        missing = ", ".join(cfg.FindInitializationErrors())
+        raise ConfigError(f"configuration is missing required field(s): {missing}")
+    verbosity = args.verbose
+    debug_cfg = False
+    if "app" in fields:
+        if cfg.app.HasField("glog_config") and cfg.app.glog_config.HasField("tty_verbosity"):
+            verbosity = max(verbosity, _TTY_VERBOSITY.get(cfg.app.glog_config.tty_verbosity, 0))
+        debug_cfg = cfg.app.debug_cfg
+    return LoadedConfig(cfg, verbosity, False, debug_cfg)
+
+
+def _is_repeated(field: pb_descriptor.FieldDescriptor) -> bool:
+    return bool(field.is_repeated)
+
+
+def _is_required(field: pb_descriptor.FieldDescriptor) -> bool:
+    return bool(field.is_required)
+
+
+_TYPE_NAMES = {
+    _FD.TYPE_DOUBLE: "double", _FD.TYPE_FLOAT: "float", _FD.TYPE_INT64: "int64", _FD.TYPE_UINT64: "uint64",
+    _FD.TYPE_INT32: "int32", _FD.TYPE_FIXED64: "fixed64", _FD.TYPE_FIXED32: "fixed32", _FD.TYPE_BOOL: "bool",
+    _FD.TYPE_STRING: "string", _FD.TYPE_BYTES: "bytes", _FD.TYPE_UINT32: "uint32", _FD.TYPE_SFIXED32: "sfixed32",
+    _FD.TYPE_SFIXED64: "sfixed64", _FD.TYPE_SINT32: "sint32", _FD.TYPE_SINT64: "sint64",
+}
+
+
+def _type_label(field: pb_descriptor.FieldDescriptor) -> str:
+    if field.type == _FD.TYPE_ENUM:
+        return f"enum {field.enum_type.name}"
+    if field.type == _FD.TYPE_MESSAGE:
+        return field.message_type.full_name
+    return _TYPE_NAMES.get(field.type, "?")
+
+
+def _example_value(field: pb_descriptor.FieldDescriptor) -> str:
+    if field.has_default_value or field.type in (_FD.TYPE_ENUM, _FD.TYPE_BOOL):
+        value: Any = field.default_value
+        if field.type == _FD.TYPE_ENUM:
+            enum_value = field.enum_type.values_by_number.get(value) or field.enum_type.values[0]
+            return enum_value.name
+    else:
+        value = {_FD.TYPE_STRING: "", _FD.TYPE_BYTES: b""}.get(field.type, 0)
+    if field.type == _FD.TYPE_BOOL:
+        return "true" if value else "false"
+    if field.type == _FD.TYPE_STRING:
+        return '"' + str(value).replace('"', '\\"') + '"'
+    if field.type == _FD.TYPE_BYTES:
+        return '"' + value.decode(errors="replace") + '"'
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def example_config(config_type: type[pb_message.Message] | pb_descriptor.Descriptor, _indent: int = 0,
+                   _seen: tuple[str, ...] = ()) -> str:
+    """Every field of the configuration with its default, each commented with label, type and meaning.
+
+    The text parses back into ``config_type`` and, as given, changes nothing that matters: fields that would alter
+    behaviour just by being present are commented out (optional fields without a declared default, repeated
+    fields, later members of a oneof, optional blocks that contain required fields).  Required fields stay.
+    """
+    descriptor = config_type if isinstance(config_type, pb_descriptor.Descriptor) else config_type.DESCRIPTOR
+    pad = "  " * _indent
+    lines: list[str] = []
+    for field in descriptor.fields:
+        label = "required" if _is_required(field) else "repeated" if _is_repeated(field) else "optional"
+        comment = f"({label}) {_type_label(field)}"
+        if field.has_default_value:
+            comment += f", default {_example_value(field)}"
+        oneof = field.containing_oneof
+        off = "# " if _comment_out(field) else ""
+        if oneof is not None:
+            comment += f"; one of {oneof.name}"
+        if field.type == _FD.TYPE_MESSAGE:
+            sub = field.message_type
+            if sub.full_name in _seen or len(_seen) > 6:
+                lines.append(f"{pad}# {field.name} {{ }}  # {comment} (recursive, not expanded)")
+                continue
+            lines.append(f"{pad}{off}{field.name} {{  # {comment}")
+            body = example_config(sub, _indent + 1, (*_seen, descriptor.full_name))
+            if off:
+                body = "\n".join(f"{pad}# {line[len(pad):]}" for line in body.splitlines())
+            if body:
+                lines.append(body)
+            lines.append(f"{pad}{off}}}")
+        else:
+            lines.append(f"{pad}{off}{field.name}: {_example_value(field)}  # {comment}")
+    return "\n".join(lines)
+
+
+def _comment_out(field: pb_descriptor.FieldDescriptor) -> bool:
+    if _is_required(field):
+        return False
+    oneof = field.containing_oneof
+    if oneof is not None and oneof.fields[0] is not field:
+        return True
+    if _is_repeated(field):
+        return True
+    if field.type == _FD.TYPE_MESSAGE:
+        return any(_is_required(sub) for sub in field.message_type.fields)
+    return not field.has_default_value
+
+
+def debug_text(cfg: pb_message.Message) -> str:
+    """The parsed configuration as text format (what ``app { debug_cfg: true }`` prints)."""
+    return text_format.MessageToString(cfg)
+
+
+def load_for_run(config_type: type[pb_message.Message], argv: list[str] | None, prog: str) -> LoadedConfig | int:
+    """The start-up every Goby-style program shares: parse, or handle ``--example_config``/``debug_cfg``.
+
+    Returns the loaded configuration to run with, or the exit code to return at once: 0 after printing the
+    example or the parsed configuration, 2 after printing a configuration error naming the cause.
+    """
+    try:
+        loaded = load_config(config_type, argv, prog)
+    except ConfigError as exc:
+        print(f"{prog}: configuration error: {exc}", file=sys.stderr)
+        return 2
+    if loaded.example_requested:
+        print(example_config(config_type))
+        return 0
+    if loaded.debug_cfg:
+        print(debug_text(loaded.cfg), end="")
+        return 0
+    return loaded

@@ -1,0 +1,20 @@
+from gateway.goby.protobuf import app_config_pb2 as _app_config_pb2
+from gateway.goby.protobuf import interprocess_config_pb2 as _interprocess_config_pb2
+from google.protobuf import descriptor as _descriptor
+from google.protobuf import message as _message
+from collections.abc import Mapping as _Mapping
+from typing import ClassVar as _ClassVar, Optional as _Optional, Union as _Union
+
+DESCRIPTOR: _descriptor.FileDescriptor
+
+class GobyDaemonConfig(_message.Message):
+    __slots__ = ("app", "router_threads", "interprocess", "hold")
+    APP_FIELD_NUMBER: _ClassVar[int]
+    ROUTER_THREADS_FIELD_NUMBER: _ClassVar[int]
+    INTERPROCESS_FIELD_NUMBER: _ClassVar[int]
+    HOLD_FIELD_NUMBER: _ClassVar[int]
+    app: _app_config_pb2.AppConfig
+    router_threads: int
+    interprocess: _interprocess_config_pb2.InterProcessPortalConfig
+    hold: _interprocess_config_pb2.InterProcessManagerHold
+    def __init__(self, app: _Optional[_Union[_app_config_pb2.AppConfig, _Mapping]] = ..., router_threads: _Optional[int] = ..., interprocess: _Optional[_Union[_interprocess_config_pb2.InterProcessPortalConfig, _Mapping]] = ..., hold: _Optional[_Union[_interprocess_config_pb2.InterProcessManagerHold, _Mapping]] = ...) -> None: ...

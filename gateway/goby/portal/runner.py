@@ -1,0 +1,112 @@
+"""``run_application``: config, logging, warp, signals, the application's lifetime, and the exit code."""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable
+from typing import Any
+
+from google.protobuf import message as pb_message
+
+from gateway.goby.portal.config import load_for_run
+from gateway.goby.portal.context import ProcessContext, use_context
+from gateway.goby.portal.errors import BrokerUnavailableError
+from gateway.goby.portal.interface_registry import process_registry
+from gateway.goby.portal.thread import SimpleThread, interprocess_config_of
+from gateway.goby.portal.timeutil import SystemClock
+from gateway.goby.portal.timeutil import clock as process_clock
+from util.logsetup import configure_logging
+
+log = logging.getLogger(__name__)
+
+
+def apply_simulation_time(cfg: Any, clock: SystemClock = process_clock) -> None:
+    """Apply ``app.simulation.time`` (use_sim_time, warp_factor, reference_microtime) to ``clock``."""
+    descriptor = getattr(cfg, "DESCRIPTOR", None)
+    if descriptor is None or "app" not in descriptor.fields_by_name:
+        return
+    sim = cfg.app.simulation.time
+    if sim.use_sim_time:
+        reference = sim.reference_microtime if sim.HasField("reference_microtime") else None
+        clock.configure(True, sim.warp_factor, reference)
+        log.info("simulation time on: warp %d, reference %d µs", clock.warp_factor, clock.reference_micro)
+
+
+def run_application(
+    app_class: Callable[[Any], SimpleThread],
+    config_type: type[pb_message.Message],
+    argv: list[str] | None = None,
+    *,
+    prog: str | None = None,
+) -> int:
+    """Parse the configuration and run ``app_class(cfg)`` until it quits or SIGINT/SIGTERM; returns the exit code.
+
+    Exit codes: the application's ``quit(code)``; 0 for ``--example_config`` and ``debug_cfg``; 1 when the broker
+    does not answer or the application fails; 2 for a bad configuration.
+    """
+    prog = prog or os.path.basename(sys.argv[0] or "app")
+    loaded = load_for_run(config_type, argv, prog)
+    if isinstance(loaded, int):
+        return loaded
+    cfg = loaded.cfg
+    app_name = cfg.app.name if "app" in cfg.DESCRIPTOR.fields_by_name else prog
+    configure_logging(loaded.verbosity, app_name)
+    apply_simulation_time(cfg)
+    context = ProcessContext(interprocess_config_of(cfg), application=app_name)
+    app: SimpleThread | None = None
+    stop_requested = threading.Event()  # a signal during construction must not be lost
+
+    def on_signal() -> None:
+        stop_requested.set()
+        if app is not None:
+            app.quit()
+
+    restore = _install_signal_handlers(on_signal)
+    try:
+        with use_context(context):
+            try:
+                app = app_class(cfg)
+                if stop_requested.is_set():
+                    app.quit()
+            except BrokerUnavailableError as exc:
+                log.critical("%s", exc)
+                return 1
+            except Exception:
+                log.exception("%s failed to start", app_name)
+                return 1
+            try:
+                app.run()
+            except Exception:
+                log.exception("%s failed", app_name)
+                return 1
+            return int(getattr(app, "return_code", 0))
+    finally:
+        if app is not None:
+            app.close()
+        context.close()
+        restore()
+        process_registry.write_if_requested()
+
+
+def _install_signal_handlers(on_signal: Callable[[], None]) -> Callable[[], None]:
+    """SIGINT/SIGTERM -> ``on_signal`` (clean shutdown); returns a function restoring the previous handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+    previous = {}
+
+    def handler(signum: int, _frame: object) -> None:
+        log.info("received %s; shutting down", signal.Signals(signum).name)
+        on_signal()
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        previous[sig] = signal.signal(sig, handler)
+
+    def restore() -> None:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+    return restore

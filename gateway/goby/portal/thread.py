@@ -1,0 +1,182 @@
+"""``SimpleThread``: a Goby thread with a loop frequency, its own transports, and ``call_soon``.
+
+Construct a thread on the thread that runs it (``MultiThreadApplication.launch_thread`` does this) so its
+sockets and identifiers belong to that thread.  Subscription callbacks, ``call_soon`` work and ``loop()`` all run
+on that one thread, never concurrently.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable
+from typing import Any
+
+from gateway.goby.portal.context import ProcessContext, current_context
+from gateway.goby.portal.interprocess import InterProcessPortal
+from gateway.goby.portal.interthread import InterThreadTransporter
+from gateway.goby.portal.transports import ThreadTransports
+from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+
+log = logging.getLogger(__name__)
+
+
+def interprocess_config_of(cfg: Any) -> InterProcessPortalConfig | None:
+    """The ``interprocess`` block of an application config, if its type has one."""
+    descriptor = getattr(cfg, "DESCRIPTOR", None)
+    if descriptor is None or "interprocess" not in descriptor.fields_by_name:
+        return None
+    return cfg.interprocess
+
+
+def app_name_of(cfg: Any, default: str = "") -> str:
+    descriptor = getattr(cfg, "DESCRIPTOR", None)
+    if descriptor is not None and "app" in descriptor.fields_by_name and cfg.app.HasField("name"):
+        return cfg.app.name
+    return default
+
+
+class SimpleThread:
+    """Base for threads: override ``loop()`` (run at ``loop_frequency_hz * warp``), ``initialize()``, ``finalize()``.
+
+    Subscribe in ``__init__`` or ``initialize()``; the thread owns its subscriptions and drops them on exit.
+    """
+
+    def __init__(self, cfg: Any, loop_frequency_hz: float = 0.0, index: int = -1) -> None:
+        context = current_context()
+        self._owns_context = context is None
+        if context is None:
+            context = ProcessContext(
+                interprocess_config_of(cfg), application=app_name_of(cfg, type(self).__qualname__)
+            )
+        self._context: ProcessContext = context
+        self._cfg = cfg
+        self._index = index
+        self._loop_hz = float(loop_frequency_hz)
+        self._transports = ThreadTransports(context, type(self).__qualname__)
+        self._alive = True
+        self._closed = False
+        self._next_loop: float | None = None
+
+    # ------------------------------------------------------------------------------------ accessors
+    def cfg(self) -> Any:
+        """The configuration this thread was built with."""
+        return self._cfg
+
+    @property
+    def index(self) -> int:
+        return self._index
+
+    @property
+    def context(self) -> ProcessContext:
+        return self._context
+
+    @property
+    def loop_frequency_hz(self) -> float:
+        """The configured loop frequency (before warp)."""
+        return self._loop_hz
+
+    def effective_loop_frequency_hz(self) -> float:
+        """The real-time loop frequency: configured frequency times the clock's warp factor."""
+        return self._loop_hz * self._context.clock.effective_warp
+
+    def interprocess(self) -> InterProcessPortal:
+        """This thread's interprocess transporter (connects to the broker on first use)."""
+        return self._transports.interprocess()
+
+    def interthread(self) -> InterThreadTransporter:
+        """This thread's interthread transporter."""
+        return self._transports.interthread()
+
+    @property
+    def alive(self) -> bool:
+        return self._alive
+
+    # ------------------------------------------------------------------------------------ overrides
+    def initialize(self) -> None:
+        """Called on the thread before the first ``loop()``."""
+
+    def loop(self) -> None:
+        """Called on the thread at the loop frequency (never while a callback runs)."""
+
+    def finalize(self) -> None:
+        """Called on the thread after the last ``loop()``, before its transports close."""
+
+    # ------------------------------------------------------------------------------ cross-thread API
+    def call_soon(self, fn: Callable[[], Any]) -> None:
+        """Run ``fn()`` on this thread as soon as possible; callable from any thread.
+
+        Wakes the thread's poll through an eventfd, so the delay is the wake-up time of the thread (tens of µs),
+        not a loop period.  Exceptions from ``fn`` are logged and the thread keeps running.  Raises
+        ``ClosedError`` once the thread has closed (work handed over during shutdown is not dropped silently).
+        """
+        self._transports.mailbox.post(fn)
+
+    def quit(self) -> None:
+        """Ask the thread to leave its run loop (thread-safe; idempotent)."""
+        self._alive = False
+        self._transports.mailbox.wake()
+
+    # ---------------------------------------------------------------------------------- run loop
+    def poll(self, timeout_s: float | None = 0.0) -> int:
+        """Run pending callbacks for up to ``timeout_s``; for code that drives a thread object by hand."""
+        return self._transports.poll(timeout_s)
+
+    def run_once(self) -> None:
+        """One iteration: poll until the next loop tick (or an event), then ``loop()`` if the tick is due.
+
+        Unlike Goby (which calls ``loop()`` only when a poll times out), a due tick runs even under steady
+        traffic, so heavy subscriptions cannot starve ``loop()``.
+        """
+        hz = self.effective_loop_frequency_hz()
+        if hz <= 0:
+            self._transports.poll(None)
+            return
+        if math.isinf(hz):
+            self._transports.poll(0.0)
+            self.loop()
+            return
+        interval = 1.0 / hz
+        now = time.monotonic()
+        if self._next_loop is None:
+            self._next_loop = (math.floor(now / interval) + 1) * interval
+        self._transports.poll(max(0.0, self._next_loop - now))
+        now = time.monotonic()
+        if now >= self._next_loop and self._alive:
+            self.loop()
+            self._next_loop += interval
+            if self._next_loop <= now:  # fell behind: skip the missed ticks rather than bursting
+                self._next_loop = (math.floor(now / interval) + 1) * interval
+
+    def run(self) -> None:
+        """``initialize()``, loop until ``quit()``, ``finalize()``; runs on the calling thread."""
+        self.initialize()
+        self._after_initialize()
+        try:
+            while self._alive:
+                self.run_once()
+        finally:
+            self.finalize()
+
+    def _after_initialize(self) -> None:
+        """Report ``ready`` to the manager when this thread runs its own process context (applications too)."""
+        if self._owns_context and self._transports.has_interprocess:
+            self.interprocess().ready()
+
+    # ---------------------------------------------------------------------------------- shutdown
+    def close(self) -> None:
+        """Close the transports (and the process context if this thread created it); idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        self._alive = False
+        self._transports.close()
+        if self._owns_context:
+            self._context.close()
+
+    def __enter__(self) -> SimpleThread:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

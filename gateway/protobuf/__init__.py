@@ -1,1 +1,0 @@
-"""Protobuf support shared by every package: the code generator and third-party-shaped include files."""

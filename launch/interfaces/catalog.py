@@ -1,0 +1,20 @@
+"""The applications we ship, and the modules whose code makes up each one's interface.
+
+Only the listed modules are analysed (as goby_clang_tool sees only a target's own sources): a plugin that
+imports another plugin's module does not inherit its calls. A gateway plugin is listed as its own entry whose interface is merged into ``moos-gateway`` in a deployment
+(the ``application:`` override of a deployment entry), as Goby lists its plugin libraries.
+"""
+
+from __future__ import annotations
+
+SHIPPED_APPLICATIONS: dict[str, list[str]] = {
+    "frontseat-interface": ["frontseat.interface_app"],
+    "usv-manager": ["translators.apps.usv_manager"],
+    "usv-command": ["translators.apps.usv_command"],
+    "moos-gateway-frontseat-plugin": ["translators.frontseat.translation"],
+    "moos-gateway-usv-command-plugin": ["translators.usv.command_translation"],
+    "moos-gateway-node-report-plugin": ["translators.node_report"],
+    "goby-helm-example": ["behaviors.apps.goby_helm_example"],
+    "usv-mission-shore": ["launch.usv.shore"],
+    "usv-mission-recorder": ["launch.usv.recorder"],
+}

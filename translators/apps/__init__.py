@@ -1,0 +1,1 @@
+"""Applications of the translators tree (console scripts), kept apart from the libraries they wire together."""

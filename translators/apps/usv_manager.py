@@ -1,0 +1,61 @@
+"""usv-manager: receives USV commands from shore and republishes them on the vehicle's interprocess.
+
+The Goby3 course's goby3_course_usv_manager subscribes to ``usv_command`` on intervehicle (satellite link, with
+ack) and republishes each command on interprocess, where CommandTranslation picks it up. Here shore and vehicle
+share a broker: the shore leg is the group ``goby3_course::shore::usv_command`` (see ``translators.usv.groups``).
+Commands outside their DCCL bounds are refused here, with an acknowledgement that says why, so they never reach
+the vehicle's interprocess.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from google.protobuf import text_format
+
+from gateway.goby.portal import SingleThreadApplication, run_application
+from translators.usv import groups
+from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
+from translators.usv.protobuf.command_dccl_pb2 import USVCommand
+from translators.usv.protobuf.usv_config_pb2 import USVManager as USVManagerConfig
+from translators.usv.validation import DcclBoundsError, check_dccl_bounds
+
+log = logging.getLogger(__name__)
+
+
+class USVManager(SingleThreadApplication):
+    """Forwards shore commands to the vehicle's interprocess, acknowledging (or refusing) each one."""
+
+    def __init__(self, cfg: USVManagerConfig) -> None:
+        super().__init__(cfg)
+        self.interprocess().subscribe(groups.shore_usv_command, USVCommand, self._on_shore_command)
+        log.info("waiting for USV commands on %s", groups.shore_usv_command)
+
+    def _on_shore_command(self, command: USVCommand) -> None:
+        """Check, republish and acknowledge one command. Runs on the application's main thread."""
+        text = text_format.MessageToString(command, as_one_line=True)
+        log.info("Received USVCommand: %s", text)
+        ack = USVCommandAck(responder=self.app_name(), command=text)
+        if command.HasField("time"):
+            ack.command_time = command.time
+        try:
+            checked = check_dccl_bounds(command)
+        except DcclBoundsError as error:
+            log.error("refusing USVCommand %s: %s", text, error)
+            ack.stage = USVCommandAck.REFUSED
+            ack.error = str(error)
+            self.interprocess().publish(groups.usv_command_ack, ack)
+            return
+        # Ack first: from one publisher the broker keeps order, so the sender hears from us before the translator.
+        ack.stage = USVCommandAck.RECEIVED_BY_MANAGER
+        self.interprocess().publish(groups.usv_command_ack, ack)
+        self.interprocess().publish(groups.usv_command, checked)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Console script ``usv-manager``: Goby-style config file / ``--interprocess`` / ``GOBY_INTERPROCESS``."""
+    return run_application(USVManager, USVManagerConfig, argv, prog="usv-manager")
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,100 @@
+"""FrontSeatTranslation: pHelmIvP <-> the frontseat interface (Goby3's ``goby::moos::FrontSeatTranslation``).
+
+Goby -> MOOS: each ``node_status`` becomes the NAV_* variables pHelmIvP and pNodeReporter read.
+MOOS -> Goby: DESIRED_SPEED (with the other buffered DESIRED_*) becomes a ``desired_course``; IVPHELM_STATE
+becomes a ``helm_state`` report. Runs as a gateway plugin (``load``/``unload``) and embedded in
+frontseat-interface, which launches it with a GobyMOOSGatewayConfig whose ``app.geodesy`` is the datum.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from frontseat import groups
+from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
+from frontseat.protobuf.frontseat_pb2 import HelmState, HelmStateReport
+from frontseat.protobuf.navigation_pb2 import DatumUpdate
+from gateway.goby.portal import MultiThreadApplication
+from gateway.moos import MoosMessage
+from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from translators.base import Translator
+from translators.frontseat.helm_conversion import (
+    BUFFERED_SETPOINTS,
+    DESIRED_SPEED,
+    IVPHELM_STATE,
+    SetpointError,
+    desired_course,
+    helm_state,
+)
+from translators.frontseat.nav_conversion import nav_posts
+from util.geodesy import UTMGeodesy
+
+log = logging.getLogger(__name__)
+
+
+def geodesy_from_config(cfg: GobyMOOSGatewayConfig) -> UTMGeodesy | None:
+    """The local grid of ``cfg.app.geodesy``, or None when no datum is configured."""
+    if not cfg.app.HasField("geodesy"):
+        return None
+    return UTMGeodesy(cfg.app.geodesy.lat_origin, cfg.app.geodesy.lon_origin)
+
+
+class FrontSeatTranslation(Translator):
+    """Moves navigation to the helm and the helm's setpoints and state to the frontseat interface."""
+
+    def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None) -> None:
+        super().__init__(cfg, index, comms_kind=comms_kind)
+        self._geodesy = geodesy_from_config(cfg)
+        if self._geodesy is None:
+            log.warning("no app.geodesy datum configured: NAV_X/NAV_Y will be copied from node_status local_fix")
+        for variable in BUFFERED_SETPOINTS:
+            self.moos().add_buffer(variable)
+        self.moos().add_trigger(DESIRED_SPEED, self._on_desired_speed)
+        self.moos().add_trigger(IVPHELM_STATE, self._on_helm_state)
+        interprocess = self.goby().interprocess()
+        interprocess.subscribe(groups.node_status, NodeStatus, self._on_node_status)
+        interprocess.subscribe(groups.datum_update, DatumUpdate, self._on_datum_update)
+
+    def _on_node_status(self, status: NodeStatus) -> None:
+        """Post NAV_* for one NodeStatus. Runs on the translator's thread."""
+        comms = self.moos().comms()
+        for name, value in nav_posts(status, self._geodesy):
+            comms.notify(name, value)
+        log.debug("posted NAV_* for node_status at time %.3f", status.time)
+
+    def _on_datum_update(self, update: DatumUpdate) -> None:
+        """Move the local grid's origin, as Goby applications do. Runs on the translator's thread."""
+        try:
+            self._geodesy = UTMGeodesy(update.datum.lat, update.datum.lon)
+        except ValueError as error:
+            log.error("ignoring datum_update: %s", error)
+            return
+        log.info("datum updated to lat=%.8f lon=%.8f", update.datum.lat, update.datum.lon)
+
+    def _on_desired_speed(self, msg: MoosMessage) -> None:
+        """Publish a DesiredCourse built from the buffered setpoints. Runs on the translator's thread."""
+        try:
+            course, errors = desired_course(msg, self.moos().buffer())
+        except SetpointError as error:
+            log.error("no desired_course published: %s", error)
+            return
+        for error in errors:
+            log.error("setpoint left out of desired_course: %s", error)
+        self.goby().interprocess().publish(groups.desired_course, course)
+        log.debug("posting to Goby: desired_course %s", course)
+
+    def _on_helm_state(self, msg: MoosMessage) -> None:
+        """Publish a HelmStateReport for every IVPHELM_STATE. Runs on the translator's thread."""
+        report = HelmStateReport(state=helm_state(msg.string()))
+        self.goby().interprocess().publish(groups.helm_state, report)
+        log.debug("IVPHELM_STATE %r -> helm_state %s", msg.string(), HelmState.Name(report.state))
+
+
+def load(gateway: MultiThreadApplication) -> None:
+    """Plugin entry (as Goby's ``goby3_moos_gateway_load``): launch the translator. Runs on the gateway's main thread."""
+    gateway.launch_thread(FrontSeatTranslation)
+
+
+def unload(gateway: MultiThreadApplication) -> None:
+    """Plugin exit: join the translator thread. Runs on the gateway's main thread."""
+    gateway.join_thread(FrontSeatTranslation)
