@@ -214,7 +214,7 @@ def test_format_parse_empty_double_is_nan(pb):
 
 
 def test_technique_numbers_follow_the_proto():
-    from translators.protobuf.translator_pb2 import TranslatorEntry
+    from gateway.moos_gateway.protobuf.translator_pb2 import TranslatorEntry
 
     for technique in Technique:
         assert TranslatorEntry.ParserSerializerTechnique.Value(technique.proto_name) == technique

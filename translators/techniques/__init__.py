@@ -12,7 +12,7 @@ from enum import IntEnum
 from google.protobuf import descriptor_pool as _descriptor_pool
 from google.protobuf.message import Message
 
-from translators.protobuf.translator_pb2 import TranslatorEntry
+from gateway.moos_gateway.protobuf.translator_pb2 import TranslatorEntry
 from translators.techniques.errors import TechniqueError
 from translators.techniques.format_technique import format_message, parse_format
 from translators.techniques.key_value import from_key_values, to_key_values, value_for_key

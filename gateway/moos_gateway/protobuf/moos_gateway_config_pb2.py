@@ -24,18 +24,18 @@ _sym_db = _symbol_database.Default()
 
 from gateway.goby.protobuf import app_config_pb2 as gateway_dot_goby_dot_protobuf_dot_app__config__pb2
 from gateway.goby.protobuf import interprocess_config_pb2 as gateway_dot_goby_dot_protobuf_dot_interprocess__config__pb2
-from translators.protobuf import translator_pb2 as translators_dot_protobuf_dot_translator__pb2
+from gateway.moos_gateway.protobuf import translator_pb2 as gateway_dot_moos__gateway_dot_protobuf_dot_translator__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n7gateway/moos_gateway/protobuf/moos_gateway_config.proto\x12\x17goby.apps.moos.protobuf\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\x1a%translators/protobuf/translator.proto\"\xe9\x03\n\x15GobyMOOSGatewayConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12G\n\x04moos\x18\x03 \x01(\x0b\x32\x39.goby.apps.moos.protobuf.GobyMOOSGatewayConfig.MOOSConfig\x12\x1a\n\x0epoll_frequency\x18\x14 \x01(\x02:\x02\x31\x30\x1a\xe7\x01\n\nMOOSConfig\x12\x19\n\x06server\x18\x03 \x01(\t:\tlocalhost\x12\x12\n\x04port\x18\x04 \x01(\x05:\x04\x39\x30\x30\x30\x12\"\n\x13use_binary_protobuf\x18m \x01(\x08:\x05\x66\x61lse\x12\x85\x01\n\x15moos_parser_technique\x18n \x01(\x0e\x32=.goby.moos.protobuf.TranslatorEntry.ParserSerializerTechnique:\'TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n7gateway/moos_gateway/protobuf/moos_gateway_config.proto\x12\x17goby.apps.moos.protobuf\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\x1a.gateway/moos_gateway/protobuf/translator.proto\"\xe9\x03\n\x15GobyMOOSGatewayConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12G\n\x04moos\x18\x03 \x01(\x0b\x32\x39.goby.apps.moos.protobuf.GobyMOOSGatewayConfig.MOOSConfig\x12\x1a\n\x0epoll_frequency\x18\x14 \x01(\x02:\x02\x31\x30\x1a\xe7\x01\n\nMOOSConfig\x12\x19\n\x06server\x18\x03 \x01(\t:\tlocalhost\x12\x12\n\x04port\x18\x04 \x01(\x05:\x04\x39\x30\x30\x30\x12\"\n\x13use_binary_protobuf\x18m \x01(\x08:\x05\x66\x61lse\x12\x85\x01\n\x15moos_parser_technique\x18n \x01(\x0e\x32=.goby.moos.protobuf.TranslatorEntry.ParserSerializerTechnique:\'TECHNIQUE_PREFIXED_PROTOBUF_TEXT_FORMAT*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'gateway.moos_gateway.protobuf.moos_gateway_config_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_GOBYMOOSGATEWAYCONFIG']._serialized_start=213
-  _globals['_GOBYMOOSGATEWAYCONFIG']._serialized_end=702
-  _globals['_GOBYMOOSGATEWAYCONFIG_MOOSCONFIG']._serialized_start=460
-  _globals['_GOBYMOOSGATEWAYCONFIG_MOOSCONFIG']._serialized_end=691
+  _globals['_GOBYMOOSGATEWAYCONFIG']._serialized_start=222
+  _globals['_GOBYMOOSGATEWAYCONFIG']._serialized_end=711
+  _globals['_GOBYMOOSGATEWAYCONFIG_MOOSCONFIG']._serialized_start=469
+  _globals['_GOBYMOOSGATEWAYCONFIG_MOOSCONFIG']._serialized_end=700
 # @@protoc_insertion_point(module_scope)

@@ -1,6 +1,6 @@
 from gateway.goby.protobuf import app_config_pb2 as _app_config_pb2
 from gateway.goby.protobuf import interprocess_config_pb2 as _interprocess_config_pb2
-from translators.protobuf import translator_pb2 as _translator_pb2
+from gateway.moos_gateway.protobuf import translator_pb2 as _translator_pb2
 from google.protobuf.internal import python_message as _python_message
 from google.protobuf import descriptor as _descriptor
 from google.protobuf import message as _message
