@@ -3,8 +3,9 @@
 It loads one driver (``FRONTSEAT_DRIVER_LIBRARY``), ticks it at 10 Hz times warp on the main thread, and
 bridges it to the interprocess portal with Goby's groups and state gating: commands reach the frontseat
 only in COMMAND, data and raw in LISTEN or COMMAND. Status goes out every ``status_period`` (simulated)
-seconds. With a ``[goby.moos.protobuf.moos_helm]`` block it also runs the FrontSeatTranslation thread,
-which connects pHelmIvP (or any MOOS helm) through a MOOSDB.
+seconds. With a ``[goby.moos.protobuf.moos_helm]`` block it also runs the MOOS helm interface thread (found by
+entry point ``moos_helm``: the translators' FrontSeatTranslation), which connects pHelmIvP (or any MOOS helm)
+through a MOOSDB.
 
 Threading: every subscription callback, the driver's signals and the driver itself run on the main thread.
 """
@@ -19,16 +20,23 @@ from functools import partial
 
 from frontseat import groups
 from frontseat.driver import FrontSeatDriver
-from frontseat.errors import DriverLoadError, FrontSeatException
-from frontseat.loading import ENV_VAR, DriverFactory, driver_factory, load_driver_library
+from frontseat.errors import FrontSeatException
+from frontseat.loading import (
+    ENV_VAR,
+    DriverFactory,
+    driver_factory,
+    helm_interface_class,
+    load_driver_library,
+)
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_interface_config_pb2 as app_pb
 from frontseat.protobuf import frontseat_pb2 as fs_pb
 from frontseat.protobuf import moos_helm_frontseat_interface_config_pb2 as helm_pb
 from frontseat.protobuf import navigation_pb2 as nav_pb
-from gateway.goby.portal import MultiThreadApplication, run_application
+from gateway.goby.portal import MultiThreadApplication, run_application, use_context
 from gateway.moos_gateway.protobuf import moos_gateway_config_pb2 as gateway_pb
+from util.extensions import ExtensionError
 
 log = logging.getLogger(__name__)
 
@@ -68,7 +76,8 @@ class FrontSeatInterface(MultiThreadApplication):
         self._last_failure = ""
         self._last_helm_report: float | None = None
         try:
-            self._driver: FrontSeatDriver = driver_factory(driver_config(cfg))
+            with use_context(self.context):  # the driver's default clock is this application's clock
+                self._driver: FrontSeatDriver = driver_factory(driver_config(cfg))
             self._connect_driver()
             self._subscribe()
             self._launch_helm_interface()
@@ -116,16 +125,10 @@ class FrontSeatInterface(MultiThreadApplication):
         gateway_cfg = helm_gateway_config(self.cfg())
         if gateway_cfg is None:
             return
-        log.info("launching the MOOS helm interface thread (MOOSDB %s:%d)", gateway_cfg.moos.server,
-                 gateway_cfg.moos.port)
-        try:
-            from translators.frontseat.translation import FrontSeatTranslation
-        except ImportError as exc:
-            raise FrontSeatException(
-                f"the config has a [goby.moos.protobuf.moos_helm] block but the MOOS helm interface "
-                f"(translators.frontseat.translation.FrontSeatTranslation) cannot be imported: {exc}"
-            ) from exc
-        self.launch_thread(FrontSeatTranslation, gateway_cfg)
+        helm_interface = helm_interface_class()  # ExtensionError if not installed: one line, exit 1
+        log.info("launching the MOOS helm interface thread %s (MOOSDB %s:%d)", helm_interface.__qualname__,
+                 gateway_cfg.moos.server, gateway_cfg.moos.port)
+        self.launch_thread(helm_interface, gateway_cfg)
 
     # ----- subscriptions (main thread) -------------------------------------------------------------------
     def _on_helm_state(self, report: fs_pb.HelmStateReport) -> None:
@@ -267,7 +270,7 @@ def _print_example(spec: str | None) -> int:
         print(f"Loading frontseat driver library: {spec}", file=sys.stderr)
         try:
             module = load_driver_library(spec)
-        except DriverLoadError as exc:
+        except ExtensionError as exc:
             print(f"frontseat-interface: {exc}", file=sys.stderr)
             return 1
         print(example_config(module))
@@ -276,7 +279,7 @@ def _print_example(spec: str | None) -> int:
         module = load_driver_library(EXAMPLE_DRIVER)
         note = (f"# {ENV_VAR} is unset: frontseat_cfg shows the {EXAMPLE_DRIVER} driver's block; set it to a "
                 "driver and run --example_config again for that driver's block")
-    except DriverLoadError as exc:  # not installed as a package: show the example without a driver block
+    except ExtensionError as exc:  # not installed as a package: show the example without a driver block
         log.debug("no example driver: %s", exc)
         module = None
         note = f"# {ENV_VAR} is unset: set it to a driver and run --example_config again for that driver's block"
@@ -306,7 +309,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         module = load_driver_library(spec)
         factory = driver_factory(module, spec)
-    except DriverLoadError as exc:
+    except ExtensionError as exc:
         print(f"frontseat-interface: {exc}", file=sys.stderr)
         return 1
     return run_application(

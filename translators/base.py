@@ -14,9 +14,10 @@ from __future__ import annotations
 
 import logging
 import threading
+from collections.abc import Callable
 
 import gateway.moos as moos
-from gateway.goby.portal import SimpleThread
+from gateway.goby.portal import MultiThreadApplication, SimpleThread
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from translators.moos_interface import TIME_VAR, MOOSInterface
 
@@ -24,7 +25,9 @@ log = logging.getLogger(__name__)
 
 LOOP_FREQUENCY_HZ = 10.0  # Goby hard-codes 10 Hz (poll_frequency is ignored); times the warp factor
 
-__all__ = ["LOOP_FREQUENCY_HZ", "TIME_VAR", "MOOSInterface", "Translator"]
+__all__ = ["LOOP_FREQUENCY_HZ", "TIME_VAR", "MOOSInterface", "Translator", "translator_plugin"]
+
+PluginHook = Callable[[MultiThreadApplication], None]
 
 
 class Translator(SimpleThread):
@@ -36,7 +39,7 @@ class Translator(SimpleThread):
     behind).  Triggers and buffers added before or after the connection are (re-)registered on every connect.
 
     ``comms_kind`` picks the client (``"ours"``, ``"pymoos"``, ``"auto"``; default ``GOBY_MOOS_CLIENT`` or ours),
-    see ``gateway.moos.make_comms``.
+    see ``gateway.moos.choose_client``.
     """
 
     def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None) -> None:
@@ -47,15 +50,14 @@ class Translator(SimpleThread):
         sim = cfg.app.simulation.time
         # Goby's SetMOOSTimeWarp is process-global; our client gets a clock of its own instead, so translators
         # of different gateways (or tests) in one process neither share a warp nor overwrite each other's skew.
-        # (The real pymoos has only the process-wide clock: make_comms applies this warp to it.)
+        # (The real pymoos has only the process-wide clock: choose_client applies this warp to it.)
         self._moos_clock = moos.MoosClock(float(sim.warp_factor) if sim.use_sim_time else 1.0)
-        comms = moos.make_comms(comms_kind, clock=self._moos_clock)
-        clock = self.context.clock
+        client = moos.choose_client(comms_kind, clock=self._moos_clock)
         self._moos = MOOSInterface(
-            comms,
+            client.comms,
             self.call_soon,
-            moos_time=moos.moos_time_source(comms),
-            goby_time=clock.now,
+            moos_time=client.moos_time,
+            goby_time=self.context.clock.now,
             technique=cfg.moos.moos_parser_technique,
         )
 
@@ -105,3 +107,21 @@ class Translator(SimpleThread):
 
     def __repr__(self) -> str:
         return f"<{type(self).__qualname__} {self._name}>"
+
+
+def translator_plugin(*translator_classes: type[SimpleThread]) -> tuple[PluginHook, PluginHook]:
+    """``load, unload`` for a plugin module whose plugin is these translators, one thread each (Goby's
+    ``goby3_moos_gateway_load``/``_unload``): ``load, unload = translator_plugin(MyTranslator)``.
+
+    ``load`` launches the threads in order, ``unload`` joins them; both run on the gateway's main thread.
+    """
+
+    def load(gateway: MultiThreadApplication) -> None:
+        for cls in translator_classes:
+            gateway.launch_thread(cls)
+
+    def unload(gateway: MultiThreadApplication) -> None:
+        for cls in translator_classes:
+            gateway.join_thread(cls)
+
+    return load, unload

@@ -12,9 +12,8 @@ import logging
 
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
-from gateway.goby.portal import MultiThreadApplication
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
-from translators.base import Translator
+from translators.base import Translator, translator_plugin
 from translators.frontseat.nav_conversion import node_report
 from translators.frontseat.translation import geodesy_from_config
 
@@ -38,11 +37,5 @@ class NodeReportTranslation(Translator):
         self.moos().comms().notify(NODE_REPORT, report)
 
 
-def load(gateway: MultiThreadApplication) -> None:
-    """Plugin entry: launch the translator thread. Runs on the gateway's main thread."""
-    gateway.launch_thread(NodeReportTranslation)
-
-
-def unload(gateway: MultiThreadApplication) -> None:
-    """Plugin exit: join the translator thread. Runs on the gateway's main thread."""
-    gateway.join_thread(NodeReportTranslation)
+# The plugin (``GOBY_MOOS_GATEWAY_PLUGINS``): load launches the translator, unload joins it.
+load, unload = translator_plugin(NodeReportTranslation)

@@ -24,6 +24,7 @@ from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConf
 from gateway.moos_gateway.app import GobyMOOSGateway
 from gateway.moos_gateway.plugins import ENV_VAR, Plugin
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from translators.base import translator_plugin
 
 
 def gateway_config(moos_port: int, interprocess: InterProcessPortalConfig | None = None,
@@ -46,10 +47,7 @@ def hosted_translators(cfg: GobyMOOSGatewayConfig, *translator_classes: type[Sim
     The gateway's main thread runs on a background thread; on exit it quits and every translator is joined.
     ``gateway.threads()`` gives the translator instances (inspect them only through thread-safe means).
     """
-    def load(gateway: GobyMOOSGateway) -> None:
-        for cls in translator_classes:
-            gateway.launch_thread(cls)
-
+    load, _ = translator_plugin(*translator_classes)
     plugin = Plugin("hosted_translators", None, load, None)
     context = ProcessContext(cfg.interprocess, application=cfg.app.name or "goby_moos_gateway",
                              hold_settle_s=hold_settle_s)

@@ -10,13 +10,15 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from util.extensions import ExtensionError
+
 from .behavior import Behavior
 from .errors import BehaviorFileError, ConditionError, ParamError, UnknownParamError
 from .info_buffer import InfoBuffer, Value
 from .ivp import IvPDomain
 from .logic import is_number
 from .modes import ModeEntry
-from .registry import behavior_class
+from .registry import BEHAVIOR_POINT, behavior_class
 
 
 @dataclass
@@ -199,9 +201,14 @@ def build_behaviors(bfile: BehaviorFile, domain: IvPDomain, info: InfoBuffer, ow
     """Instantiate and configure every block, in file order; any bad line raises BehaviorFileError."""
     behaviors: list[Behavior] = []
     for block in bfile.blocks:
-        cls = behavior_class(block.type_name)
+        try:
+            cls = behavior_class(block.type_name)
+        except ExtensionError as exc:
+            raise BehaviorFileError(bfile.path, block.line, block.type_name, str(exc)) from exc
         if cls is None:
-            raise BehaviorFileError(bfile.path, block.line, block.type_name, "unknown behaviour type")
+            raise BehaviorFileError(bfile.path, block.line, block.type_name,
+                                    f"unknown behaviour type (not built in, and no entry point of that name in "
+                                    f"group {BEHAVIOR_POINT.group})")
         bhv = cls(domain, info, ownship)
         for param, value, number in block.params:
             try:

@@ -1,6 +1,19 @@
-"""The behaviour types this helm knows, by their pHelmIvP names."""
+"""The behaviour types this helm knows, by their pHelmIvP names, and the entry-point group that adds more.
+
+pHelmIvP loads third-party behaviours from shared libraries (``ivp_behavior_dir``); here an installed package
+adds a ``BHV_`` type by declaring an entry point in group ``ivp_helm.behaviors`` whose name is the type and whose
+value is the class::
+
+    [project.entry-points."ivp_helm.behaviors"]
+    BHV_Pulse = "my_package.pulse:PulseBehavior"
+
+The built-in types come first (an installed package cannot replace ``BHV_Waypoint``); an entry point is imported
+only when a ``.bhv`` file names its type, through the project's one loader (``util.extensions``).
+"""
 
 from __future__ import annotations
+
+from util.extensions import ExtensionPoint, load_extension
 
 from .behavior import Behavior
 from .bhv_constant import ConstantDepthBehavior, ConstantHeadingBehavior, ConstantSpeedBehavior
@@ -14,7 +27,25 @@ BEHAVIOR_TYPES: dict[str, type[Behavior]] = {
                 ConstantDepthBehavior, StationKeepBehavior)
 }
 
+BEHAVIOR_POINT = ExtensionPoint(group="ivp_helm.behaviors", what="helm behaviour", source="a .bhv file",
+                                entry_points_only=True)
+
 
 def behavior_class(type_name: str) -> type[Behavior] | None:
-    """The class for ``BHV_Waypoint`` etc., or None for a type this helm does not implement."""
-    return BEHAVIOR_TYPES.get(type_name)
+    """The class for ``BHV_Waypoint`` etc., or None for a type neither built in nor installed.
+
+    Raises ExtensionError when an installed entry point of that name cannot be imported, does not name a
+    :class:`Behavior` subclass, or names one whose ``TYPE`` is another type.
+    """
+    builtin = BEHAVIOR_TYPES.get(type_name)
+    if builtin is not None:
+        return builtin
+    if BEHAVIOR_POINT.entry_point(type_name) is None:
+        return None
+    loaded = load_extension(BEHAVIOR_POINT, type_name)
+    if not (isinstance(loaded, type) and issubclass(loaded, Behavior)):
+        raise BEHAVIOR_POINT.error(type_name, f"the entry point names {loaded!r}, not a Behavior subclass")
+    if loaded.TYPE != type_name:
+        raise BEHAVIOR_POINT.error(type_name, f"the entry point names {loaded.__qualname__}, whose TYPE is "
+                                              f"{loaded.TYPE!r}")
+    return loaded

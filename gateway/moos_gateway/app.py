@@ -3,8 +3,9 @@
 Plugins come from ``GOBY_MOOS_GATEWAY_PLUGINS`` (see ``gateway.moos_gateway.plugins``).  They are all resolved before the
 configuration is read, so a bad entry stops the process with exit status 1 before anything runs.  The
 application then calls each plugin's ``load(gateway)`` in order (which launches its translator threads); an
-exception there stops everything already started and exits 1.  SIGINT/SIGTERM: ``unload(gateway)`` for each
-plugin (same order as loading, as Goby), every translator stops and closes its MOOS client, exit 0.
+exception there stops everything already started and exits 1 with one line naming the plugin and the cause
+(the traceback at ``-vv``).  SIGINT/SIGTERM: ``unload(gateway)`` for each plugin (same order as loading, as
+Goby), every translator stops and closes its MOOS client, exit 0.
 """
 
 from __future__ import annotations
@@ -12,9 +13,10 @@ from __future__ import annotations
 import logging
 import sys
 
-from gateway.goby.portal import MultiThreadApplication, run_application
-from gateway.moos_gateway.plugins import Plugin, PluginError, plugin_entries_from_env, resolve_plugins
+from gateway.goby.portal import MultiThreadApplication, StartError, run_application
+from gateway.moos_gateway.plugins import Plugin, plugin_entries_from_env, resolve_plugins
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from util.extensions import ExtensionError
 
 log = logging.getLogger(__name__)
 
@@ -22,7 +24,7 @@ APP_NAME = "goby_moos_gateway"
 _NO_PLUGINS_NEEDED = {"-h", "--help", "-e", "--example_config"}
 
 
-class PluginLoadError(PluginError):
+class PluginLoadError(StartError):
     """A plugin's ``load(gateway)`` raised; the message names the plugin and the exception."""
 
 
@@ -76,16 +78,12 @@ def main(argv: list[str] | None = None) -> int:
     if not _NO_PLUGINS_NEEDED.intersection(args):
         try:
             plugins = resolve_plugins(plugin_entries_from_env())
-        except PluginError as exc:
+        except ExtensionError as exc:
             print(f"{APP_NAME}: {exc}", file=sys.stderr)
             return 1
 
     def build(cfg: GobyMOOSGatewayConfig) -> GobyMOOSGateway:
-        try:
-            return GobyMOOSGateway(cfg, plugins)
-        except PluginLoadError as exc:
-            print(f"{APP_NAME}: {exc}", file=sys.stderr)
-            raise
+        return GobyMOOSGateway(cfg, plugins)
 
     return run_application(build, GobyMOOSGatewayConfig, args, prog=APP_NAME)
 

@@ -101,11 +101,13 @@ class Observer:
 
 
 @contextlib.contextmanager
-def helm_process(mission: Path, tmp_path: Path, command: list[str] | None = None) -> Iterator[subprocess.Popen]:
-    """``ivp-helm MISSION`` (or ``command``) as a child process; stopped (SIGTERM, then SIGKILL) on exit."""
+def helm_process(mission: Path, tmp_path: Path, command: list[str] | None = None,
+                 env: dict[str, str] | None = None) -> Iterator[subprocess.Popen]:
+    """``ivp-helm MISSION`` (or ``command``) as a child process, with ``env`` added to this process's
+    environment; stopped (SIGTERM, then SIGKILL) on exit."""
     log = open(tmp_path / "helm.log", "wb")
     proc = subprocess.Popen(command or [str(IVP_HELM), str(mission), "-v"], stdout=log, stderr=subprocess.STDOUT,
-                            cwd=tmp_path, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+                            cwd=tmp_path, env={**os.environ, "PYTHONUNBUFFERED": "1", **(env or {})})
     try:
         yield proc
     finally:

@@ -170,8 +170,8 @@ def test_moos_helm_block_without_the_translator_fails_clearly(tmp_path: Path, mo
 
     import pytest
 
-    from frontseat.errors import FrontSeatException
     from frontseat.protobuf import moos_helm_frontseat_interface_config_pb2 as helm_pb
+    from util.extensions import ExtensionError
 
     monkeypatch.setitem(sys.modules, "translators.frontseat.translation", None)  # import now raises ImportError
     built: list[ScriptedDriverDouble] = []
@@ -185,7 +185,9 @@ def test_moos_helm_block_without_the_translator_fails_clearly(tmp_path: Path, mo
         cfg.interprocess.CopyFrom(broker.interprocess_config())
         cfg.frontseat_cfg.SetInParent()
         cfg.Extensions[helm_pb.moos_helm].port = 9000
-        with pytest.raises(FrontSeatException, match="moos_helm.*cannot be imported"):
+        with pytest.raises(ExtensionError, match=r"^Failed to open helm interface: moos_helm, reason: entry point "
+                                                 r"moos_helm = translators.frontseat.translation:FrontSeatTranslation: "
+                                                 r"ModuleNotFoundError"):
             with running_app(partial(FrontSeatInterface, driver_factory=factory), cfg):
                 pass
     assert len(built) == 1

@@ -1,5 +1,5 @@
 """Plugin resolution (GOBY_MOOS_GATEWAY_PLUGINS) in-process, and every failure through the real console script:
-exit status 1 and a message naming the plugin and the cause."""
+exit status 1 and one line naming the plugin and the cause (the traceback only at -vv)."""
 
 from __future__ import annotations
 
@@ -16,14 +16,13 @@ from gateway.goby.portal.testing import broker_process
 from gateway.moos.testing import running_moosdb
 from gateway.moos_gateway.plugins import (
     ENV_VAR,
-    PluginError,
-    _entry_point,
-    entry_point_names,
+    PLUGIN_POINT,
     plugin_entries_from_env,
     resolve_plugin,
     resolve_plugins,
     split_plugin_list,
 )
+from util.extensions import ExtensionError
 
 
 def test_split_on_any_delimiter_keeping_empty_entries():
@@ -32,7 +31,7 @@ def test_split_on_any_delimiter_keeping_empty_entries():
 
 
 def test_unset_variable_is_an_error():
-    with pytest.raises(PluginError, match=f"Must define at least one plugin library in {ENV_VAR}"):
+    with pytest.raises(ExtensionError, match=f"Must define at least one plugin library in {ENV_VAR}"):
         plugin_entries_from_env({})
     assert plugin_entries_from_env({ENV_VAR: "x.py;y"}) == ["x.py", "y"]
 
@@ -54,12 +53,14 @@ def test_resolve_file_and_dotted_module(tmp_path, monkeypatch):
 
 
 def test_entry_points_are_selected_by_name_only():
-    names = entry_point_names()
+    names = PLUGIN_POINT.names()
     assert {"frontseat", "usv_command", "node_report"} <= set(names)
-    assert _entry_point("frontseat").value == "translators.frontseat.translation"
+    assert PLUGIN_POINT.entry_point("frontseat").value == "translators.frontseat.translation"
     # Goby's library file name is an alias of ours
-    assert _entry_point("libgoby_ivp_frontseat_moos_gateway_plugin.so").value == "translators.frontseat.translation"
-    assert _entry_point("translators.frontseat.translation") is None  # a dotted name is a module, not an entry point
+    alias = PLUGIN_POINT.entry_point("libgoby_ivp_frontseat_moos_gateway_plugin.so")
+    assert alias.value == "translators.frontseat.translation"
+    # a dotted name is a module, not an entry point
+    assert PLUGIN_POINT.entry_point("translators.frontseat.translation") is None
 
 
 def test_goby_library_path_loads_our_frontseat_plugin():
@@ -83,20 +84,21 @@ def test_resolution_errors_name_the_plugin(tmp_path, source, entry, cause):
     entry = entry.format(dir=tmp_path)
     if source is not None:
         Path(re.split("[:,]", entry)[0]).write_text(source)
-    with pytest.raises(PluginError) as info:
+    with pytest.raises(ExtensionError) as info:
         resolve_plugins(split_plugin_list(entry))
     assert cause.format(dir=tmp_path) in str(info.value)
 
 
-def _run_gateway(tmp_path: Path, plugins: str | None, config: str, timeout: float = 60) -> subprocess.CompletedProcess:
+def _run_gateway(tmp_path: Path, plugins: str | None, config: str, timeout: float = 60,
+                 extra_args: tuple[str, ...] = ()) -> subprocess.CompletedProcess:
     env = dict(os.environ)
     env.pop(ENV_VAR, None)
     if plugins is not None:
         env[ENV_VAR] = plugins
     cfg = tmp_path / "gateway.pb.cfg"
     cfg.write_text(config)
-    return subprocess.run([sys.executable, "-m", "gateway.moos_gateway.app", str(cfg)], env=env, capture_output=True,
-                          text=True, timeout=timeout, cwd=tmp_path)
+    return subprocess.run([sys.executable, "-m", "gateway.moos_gateway.app", str(cfg), *extra_args], env=env,
+                          capture_output=True, text=True, timeout=timeout, cwd=tmp_path)
 
 
 @pytest.mark.parametrize(
@@ -121,15 +123,22 @@ def test_console_script_exits_1_before_anything_runs(tmp_path, source, plugins, 
 
 
 def test_exception_in_load_stops_what_earlier_plugins_started(tmp_path):
+    """One line names the plugin and the cause; no traceback unless asked for with -vv."""
     (tmp_path / "echo.py").write_text(ECHO_PLUGIN)
     (tmp_path / "raising.py").write_text(RAISING_LOAD_PLUGIN)
     with running_moosdb() as db, broker_process(tmp_path, platform="gwload") as broker:
         config = (f"interprocess {{ {broker.interprocess_text()} }} "
                   f'moos {{ server: "127.0.0.1" port: {db.port} }}')
-        result = _run_gateway(tmp_path, f"{tmp_path}/echo.py;{tmp_path}/raising.py", config)
+        plugins = f"{tmp_path}/echo.py;{tmp_path}/raising.py"
+        result = _run_gateway(tmp_path, plugins, config)
+        verbose = _run_gateway(tmp_path, plugins, config, extra_args=("-vv",))
     assert result.returncode == 1, result.stderr
-    assert (f"plugin {tmp_path}/raising.py: load(gateway) raised ValueError: the plugin refuses to start"
-            in result.stderr)
+    cause = f"plugin {tmp_path}/raising.py: load(gateway) raised ValueError: the plugin refuses to start"
+    lines = [line for line in result.stderr.splitlines() if "raising.py" in line or "refuses" in line]
+    assert len(lines) == 1 and cause in lines[0], result.stderr
+    assert "Traceback" not in result.stderr
+    assert verbose.returncode == 1, verbose.stderr
+    assert cause in verbose.stderr and "Traceback (most recent call last)" in verbose.stderr
 
 
 def test_example_config_needs_no_plugins(tmp_path):

@@ -14,10 +14,9 @@ from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
 from frontseat.protobuf.frontseat_pb2 import HelmState, HelmStateReport
 from frontseat.protobuf.navigation_pb2 import DatumUpdate
-from gateway.goby.portal import MultiThreadApplication
 from gateway.moos import MoosMessage
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
-from translators.base import Translator
+from translators.base import Translator, translator_plugin
 from translators.frontseat.helm_conversion import (
     BUFFERED_SETPOINTS,
     DESIRED_SPEED,
@@ -90,11 +89,5 @@ class FrontSeatTranslation(Translator):
         log.debug("IVPHELM_STATE %r -> helm_state %s", msg.string(), HelmState.Name(report.state))
 
 
-def load(gateway: MultiThreadApplication) -> None:
-    """Plugin entry (as Goby's ``goby3_moos_gateway_load``): launch the translator. Runs on the gateway's main thread."""
-    gateway.launch_thread(FrontSeatTranslation)
-
-
-def unload(gateway: MultiThreadApplication) -> None:
-    """Plugin exit: join the translator thread. Runs on the gateway's main thread."""
-    gateway.join_thread(FrontSeatTranslation)
+# The plugin (``GOBY_MOOS_GATEWAY_PLUGINS``): load launches the translator, unload joins it.
+load, unload = translator_plugin(FrontSeatTranslation)

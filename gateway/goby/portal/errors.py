@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+from gateway.errors import GatewayError
 
-class PortalError(Exception):
+
+class PortalError(GatewayError):
     """Root of every error the portal raises."""
 
 
@@ -19,11 +21,19 @@ class IdentifierError(PortalError):
     """A received frame whose wire identifier is malformed."""
 
 
-class ConfigError(PortalError):
-    """A configuration file or command-line override that does not parse."""
+class AppConfigError(PortalError):
+    """An application's configuration (file, command-line override, required field) that cannot be used."""
 
 
-class BrokerUnavailableError(PortalError):
+class StartError(PortalError):
+    """An application cannot start, for a reason its message states in full (naming the part and the cause).
+
+    ``run_application`` prints it as one line (the traceback only at ``-vv``); any other exception from an
+    application's constructor is a bug and is printed with its traceback.
+    """
+
+
+class BrokerUnavailableError(StartError):
     """The broker's manager did not answer within ``manager_timeout_seconds``."""
 
 

@@ -14,17 +14,16 @@ from google.protobuf import message as pb_message
 
 from gateway.goby.portal.config import load_for_run
 from gateway.goby.portal.context import ProcessContext, use_context
-from gateway.goby.portal.errors import BrokerUnavailableError
-from gateway.goby.portal.interface_registry import process_registry
+from gateway.goby.portal.errors import StartError
 from gateway.goby.portal.thread import SimpleThread, interprocess_config_of
 from gateway.goby.portal.timeutil import SystemClock
-from gateway.goby.portal.timeutil import clock as process_clock
+from util.extensions import ExtensionError
 from util.logsetup import configure_logging
 
 log = logging.getLogger(__name__)
 
 
-def apply_simulation_time(cfg: Any, clock: SystemClock = process_clock) -> None:
+def apply_simulation_time(cfg: Any, clock: SystemClock) -> None:
     """Apply ``app.simulation.time`` (use_sim_time, warp_factor, reference_microtime) to ``clock``."""
     descriptor = getattr(cfg, "DESCRIPTOR", None)
     if descriptor is None or "app" not in descriptor.fields_by_name:
@@ -46,7 +45,8 @@ def run_application(
     """Parse the configuration and run ``app_class(cfg)`` until it quits or SIGINT/SIGTERM; returns the exit code.
 
     Exit codes: the application's ``quit(code)``; 0 for ``--example_config`` and ``debug_cfg``; 1 when the broker
-    does not answer or the application fails; 2 for a bad configuration.
+    does not answer or the application fails; 2 for a bad configuration.  A ``StartError`` or ``ExtensionError``
+    from the constructor is printed as one line (its traceback at ``-vv``); any other exception with its traceback.
     """
     prog = prog or os.path.basename(sys.argv[0] or "app")
     loaded = load_for_run(config_type, argv, prog)
@@ -55,8 +55,9 @@ def run_application(
     cfg = loaded.cfg
     app_name = cfg.app.name if "app" in cfg.DESCRIPTOR.fields_by_name else prog
     configure_logging(loaded.verbosity, app_name)
-    apply_simulation_time(cfg)
-    context = ProcessContext(interprocess_config_of(cfg), application=app_name)
+    clock = SystemClock()  # this run's clock, owned by its context: nothing process-wide is changed
+    apply_simulation_time(cfg, clock)
+    context = ProcessContext(interprocess_config_of(cfg), application=app_name, clock=clock)
     app: SimpleThread | None = None
     stop_requested = threading.Event()  # a signal during construction must not be lost
 
@@ -72,8 +73,9 @@ def run_application(
                 app = app_class(cfg)
                 if stop_requested.is_set():
                     app.quit()
-            except BrokerUnavailableError as exc:
+            except (StartError, ExtensionError) as exc:  # the message names the part and the cause: one line
                 log.critical("%s", exc)
+                log.debug("%s could not start", app_name, exc_info=True)
                 return 1
             except Exception:
                 log.exception("%s failed to start", app_name)
@@ -89,7 +91,7 @@ def run_application(
             app.close()
         context.close()
         restore()
-        process_registry.write_if_requested()
+        context.registry.write_if_requested()
 
 
 def _install_signal_handlers(on_signal: Callable[[], None]) -> Callable[[], None]:
