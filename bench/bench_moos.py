@@ -23,7 +23,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from bench.stats import median_p99
-from gateway.moos.factory import make_comms, pymoos_available
+from gateway.moos.factory import choose_client, pymoos_available
 from gateway.moos.testing import real_moos_skip_reason, real_moosdb, stop_process
 
 HERE = Path(__file__).resolve().parents[1]
@@ -44,7 +44,7 @@ class Waker:
 
 
 def connect(kind: str, port: int, name: str, registrations: list[str]) -> tuple[object, Waker]:
-    comms = make_comms(kind)
+    comms = choose_client(kind).comms
     comms.set_quiet(True)  # the C++ client prints connection banners on stdout otherwise
     waker = Waker()
     comms.set_on_connect_callback(lambda: all(comms.register(v, 0) for v in registrations))

@@ -20,7 +20,7 @@ import math
 from typing import Protocol
 
 from frontseat import seawater
-from frontseat.errors import ConfigError, FrontSeatErrorException, HelmErrorException
+from frontseat.errors import DriverConfigError, FrontSeatErrorException, HelmErrorException
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_pb2 as fs_pb
@@ -34,15 +34,20 @@ raw_out_log = logging.getLogger("frontseat.raw.out")
 
 
 class Clock(Protocol):
-    """Anything with ``now()`` in seconds; the portal's warped ``clock`` in the process, a fake in tests."""
+    """Anything with ``now()`` in seconds: the hosting application's warped clock, a fake in tests."""
 
     def now(self) -> float: ...
 
 
-def _process_clock() -> Clock:
-    from gateway.goby.portal import clock  # imported late: pure state-machine users need no portal
+def _application_clock() -> Clock:
+    """The clock of the application constructing the driver (its ``ProcessContext``), else real time."""
+    from gateway.goby.portal import (  # late: pure state-machine users need no portal
+        SystemClock,
+        current_context,
+    )
 
-    return clock
+    context = current_context()
+    return context.clock if context is not None else SystemClock()
 
 
 class FrontSeatDriver(abc.ABC):
@@ -57,7 +62,7 @@ class FrontSeatDriver(abc.ABC):
     def __init__(self, cfg: config_pb.Config, *, clock: Clock | None = None) -> None:
         self._cfg = config_pb.Config()
         self._cfg.CopyFrom(cfg)
-        self._clock: Clock = clock if clock is not None else _process_clock()
+        self._clock: Clock = clock if clock is not None else _application_clock()
 
         self.signal_command_response: Signal[fs_pb.CommandResponse] = Signal("command_response")
         self.signal_data_from_frontseat: Signal[fs_pb.InterfaceData] = Signal("data_from_frontseat")
@@ -297,7 +302,7 @@ def _make_geodesy(lat: float, lon: float) -> UTMGeodesy:
     try:
         return UTMGeodesy(lat, lon)
     except ValueError as exc:
-        raise ConfigError(f"failed to initialise the UTM geodesy at origin ({lat}, {lon}): {exc}") from exc
+        raise DriverConfigError(f"failed to initialise the UTM geodesy at origin ({lat}, {lon}): {exc}") from exc
 
 
 def _log_raw(logger: logging.Logger, raw: fs_pb.Raw) -> None:

@@ -2,7 +2,9 @@
 ``.moos`` mission files, and the ``moos-db`` / ``moos-poke`` / ``moos-scope`` tools.
 
 ``from gateway.moos import comms`` is a drop-in for ``import pymoos; pymoos.comms``. To use the real pymoos
-when it is importable, call :func:`make_comms` (or set ``GOBY_MOOS_CLIENT=pymoos``).
+when it is importable, call :func:`choose_client` (or set ``GOBY_MOOS_CLIENT=pymoos``).
+:data:`DEFAULT_CLOCK` exists for pymoos's process-wide API only (``time()``, ``set_moos_timewarp()``, ``comms()``
+without ``clock=``); everything else gives its client a clock of its own.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from .errors import (
     PoisonedError,
     ProtocolError,
 )
-from .factory import make_comms, moos_time_source
+from .factory import ClientChoice, choose_client
 from .message import MoosMessage
 
 moos_msg = MoosMessage  # pymoos's name for the message class
@@ -58,6 +60,7 @@ def is_little_end_in() -> bool:
 
 
 __all__ = [
+    "ClientChoice",
     "ConnectionClosedError",
     "HandshakeError",
     "MissionFileError",
@@ -66,13 +69,12 @@ __all__ = [
     "MoosMessage",
     "PoisonedError",
     "ProtocolError",
+    "choose_client",
     "comms",
     "get_moos_timewarp",
     "is_little_end_in",
     "local_time",
-    "make_comms",
     "moos_msg",
-    "moos_time_source",
     "pyMOOSException",
     "set_moos_timewarp",
     "time",

@@ -12,6 +12,7 @@ import threading
 import time as _time
 
 from .active_queue import MessageCallback
+from .clock import DEFAULT_CLOCK, MoosClock
 from .engine import Callback, ClientEngine
 from .errors import MoosError
 from .message import (
@@ -44,6 +45,9 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
     ``clock=`` gives it its own :class:`MoosClock` (warp, and the skew learned from the DB); without it the client
     shares the process-wide ``DEFAULT_CLOCK`` with ``gateway.moos.time()``, as libMOOS clients do.
     """
+
+    def __init__(self, asynchronous: bool = True, clock: MoosClock | None = None) -> None:
+        super().__init__(asynchronous, clock if clock is not None else DEFAULT_CLOCK)
 
     # ---- lifecycle ---------------------------------------------------------------------------------
     def run(self, server: str, port: int, name: str, comms_tick: float = 5) -> bool:

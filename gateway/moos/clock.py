@@ -1,11 +1,11 @@
 """MOOS time: warped unix time plus a skew, as ``MOOSLocalTime`` / ``MOOSTime``.
 
 Warp multiplies *absolute* unix time (at warp 10 timestamps are about 1.8e10). libMOOS keeps warp and skew
-process-global; here they live in a :class:`MoosClock` object. The module functions of ``gateway.moos``
-(``time``, ``local_time``, ``set_moos_timewarp``) and every client built without a clock share
-:data:`DEFAULT_CLOCK`, so pymoos scripts behave as with pymoos (one warp, one skew per process). Anything that
-may share a process with other MOOS users -- translators, tools, tests -- should give its client its own clock
-(``comms(clock=...)``, ``make_comms(..., clock=...)``): then its warp and the skew its client learns stay its own.
+process-global; here they live in a :class:`MoosClock` object. :data:`DEFAULT_CLOCK` exists for pymoos's API
+only: the module functions of ``gateway.moos`` (``time``, ``local_time``, ``set_moos_timewarp``) and ``comms()``
+built without a clock share it, so pymoos scripts behave as with pymoos (one warp, one skew per process).
+Everything else -- translators, the helm, tools, tests -- gives its client its own clock (``comms(clock=...)``,
+``choose_client(..., clock=...)``): then its warp and the skew its client learns stay its own.
 """
 
 from __future__ import annotations
@@ -58,5 +58,5 @@ class MoosClock:
 
 
 DEFAULT_CLOCK = MoosClock()
-"""The process-wide clock of pymoos-style code: ``gateway.moos.time()``/``set_moos_timewarp()`` and clients
-built without ``clock=`` (each of them writes the skew it learns here, as libMOOS clients do)."""
+"""The process-wide clock of pymoos's API: ``gateway.moos.time()``/``set_moos_timewarp()`` and ``comms()``
+built without ``clock=`` (each such client writes the skew it learns here, as libMOOS clients do)."""

@@ -21,7 +21,7 @@ from collections import deque
 from collections.abc import Callable
 
 from .active_queue import ActiveQueueRouter
-from .clock import DEFAULT_CLOCK, MoosClock
+from .clock import MoosClock
 from .codec import encode_fields, encode_message, frame_packet
 from .connection import PacketSocket, Welcome, client_handshake, open_socket
 from .errors import ConnectionClosedError, HandshakeError, MoosError, PoisonedError, ProtocolError
@@ -42,9 +42,9 @@ Callback = Callable[[], object]
 class ClientEngine:
     """State and threads of one MOOS client; ``comms`` adds the pymoos-compatible API on top."""
 
-    def __init__(self, asynchronous: bool = True, clock: MoosClock | None = None) -> None:
+    def __init__(self, asynchronous: bool, clock: MoosClock) -> None:
         self._async = asynchronous
-        self._clock = clock if clock is not None else DEFAULT_CLOCK
+        self._clock = clock
         self._lock = threading.Lock()
         self._cond = threading.Condition(self._lock)
         self._outbox: list[bytes] = []  # encoded messages, in post order

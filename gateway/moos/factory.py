@@ -1,4 +1,4 @@
-"""``make_comms``: choose our client or the real pymoos (when importable) at run time."""
+"""``choose_client``: our client or the real pymoos (when importable), chosen at run time, with its time source."""
 
 from __future__ import annotations
 
@@ -6,15 +6,26 @@ import importlib
 import logging
 import os
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
-from .clock import DEFAULT_CLOCK, MoosClock
+from .clock import MoosClock
 from .errors import MoosError
 
 log = logging.getLogger(__name__)
 
 ENV_VAR = "GOBY_MOOS_CLIENT"
 KINDS = ("auto", "ours", "pymoos")
+
+
+@dataclass(frozen=True)
+class ClientChoice:
+    """What :func:`choose_client` made: the pymoos-compatible ``comms`` object, the ``MOOSTime`` function that
+    matches it (its own clock for our client, ``pymoos.time`` for the real one) and which kind it is."""
+
+    comms: Any
+    moos_time: Callable[[], float]
+    kind: str  # "ours" or "pymoos"
 
 
 def pymoos_available() -> bool:
@@ -26,15 +37,15 @@ def pymoos_available() -> bool:
     return True
 
 
-def make_comms(kind: str | None = None, *, clock: MoosClock | None = None) -> Any:
-    """A new comms object: ``"ours"`` (this package), ``"pymoos"`` (the real binding) or ``"auto"``.
+def choose_client(kind: str | None = None, *, clock: MoosClock | None = None) -> ClientChoice:
+    """A new client: ``"ours"`` (this package), ``"pymoos"`` (the real binding) or ``"auto"``.
 
     ``kind=None`` reads ``GOBY_MOOS_CLIENT`` (default ``"ours"``). ``"auto"`` prefers the real pymoos when it is
     importable and falls back to ours. Asking for ``"pymoos"`` when it is missing raises MoosError.
 
-    ``clock`` gives our client its own :class:`MoosClock` (its warp, and the skew it learns; default: the
-    process-wide one). The real pymoos has only libMOOS's process-wide clock: there ``clock``'s warp is applied to
-    it (``pymoos.set_moos_timewarp``, as Goby's ``SetMOOSTimeWarp``) and :func:`moos_time_source` reads it.
+    ``clock`` gives our client its own :class:`MoosClock` (its warp, and the skew it learns; default: pymoos's
+    process-wide one). The real pymoos has only libMOOS's process-wide clock: there ``clock``'s warp is applied
+    to it (``pymoos.set_moos_timewarp``, as Goby's ``SetMOOSTimeWarp``).
     """
     chosen = (kind or os.environ.get(ENV_VAR) or "ours").strip().lower()
     if chosen not in KINDS:
@@ -49,19 +60,8 @@ def make_comms(kind: str | None = None, *, clock: MoosClock | None = None) -> An
             log.debug("using the real pymoos from %s", getattr(pymoos, "__file__", "?"))
             if clock is not None:
                 pymoos.set_moos_timewarp(clock.warp)
-            return pymoos.comms()
+            return ClientChoice(pymoos.comms(), pymoos.time, "pymoos")
     from .client import comms
 
-    return comms(clock=clock)
-
-
-def moos_time_source(client: Any) -> Callable[[], float]:
-    """The ``MOOSTime`` function matching ``client``: its own clock's ``time`` for our client, ``pymoos.time``
-    for the real pymoos (whose time is process-wide)."""
-    from .engine import ClientEngine
-
-    if isinstance(client, ClientEngine):
-        return client.clock.time
-    module = importlib.import_module(type(client).__module__.split(".")[0])
-    source = getattr(module, "time", None)
-    return source if callable(source) else DEFAULT_CLOCK.time
+    client = comms(clock=clock)
+    return ClientChoice(client, client.clock.time, "ours")

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import pytest
 
-from gateway.moos.clock import DEFAULT_CLOCK
 from gateway.moos.server import MoosDB
 from gateway.moos.testing import real_moos_skip_reason, real_moosdb
 
@@ -39,14 +38,3 @@ def db_port(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[int]:
         with real_moosdb(tmp_path) as (port, _):
             yield port
 
-
-@pytest.fixture(autouse=True)
-def restore_default_clock() -> Iterator[None]:
-    """Put the process-wide MOOS clock (``set_moos_timewarp``, and the skew of clients without their own clock)
-    back as it was after every test, so no test runs on a warp or skew another one left behind."""
-    warp, skew = DEFAULT_CLOCK.warp, DEFAULT_CLOCK.skew
-    try:
-        yield
-    finally:
-        DEFAULT_CLOCK.set_warp(warp)
-        DEFAULT_CLOCK.skew = skew

@@ -1,5 +1,8 @@
 """MOOS clocks: pymoos's process-wide ``time()``/``set_moos_timewarp()`` stay, and clients given their own
-:class:`MoosClock` neither read nor write the process-wide one (nor each other's)."""
+:class:`MoosClock` neither read nor write the process-wide one (nor each other's).
+
+Only the tests here that exercise pymoos's process-wide API touch ``DEFAULT_CLOCK``; they use the
+``pymoos_clock`` fixture, which puts it back.  Nothing else in the suite changes it, so no test needs a reset."""
 
 from __future__ import annotations
 
@@ -11,34 +14,41 @@ from collections.abc import Iterator
 import pytest
 
 import gateway.moos as moos
-from gateway.moos import MoosClock, comms, make_comms, moos_time_source
+from gateway.moos import MoosClock, choose_client, comms
 from gateway.moos.clock import DEFAULT_CLOCK
 from gateway.moos.testing import collect_mail, connected_comms, running_moosdb, wait_for
 
 
-def test_module_functions_keep_pymoos_process_wide_semantics():
-    """``set_moos_timewarp`` warps ``time()`` and clients without a clock, as pymoos does (the conftest
-    fixture puts the warp back afterwards)."""
+@pytest.fixture
+def pymoos_clock() -> Iterator[MoosClock]:
+    """pymoos's process-wide clock, for a test that changes it on purpose; put back as it was afterwards."""
+    warp, skew = DEFAULT_CLOCK.warp, DEFAULT_CLOCK.skew
+    try:
+        yield DEFAULT_CLOCK
+    finally:
+        DEFAULT_CLOCK.set_warp(warp)
+        DEFAULT_CLOCK.skew = skew
+
+
+def test_module_functions_keep_pymoos_process_wide_semantics(pymoos_clock):
+    """``set_moos_timewarp`` warps ``time()`` and clients without a clock, as pymoos does."""
     moos.set_moos_timewarp(7)
-    assert moos.get_moos_timewarp() == 7.0
+    assert moos.get_moos_timewarp() == 7.0 and pymoos_clock.warp == 7.0
     assert moos.local_time() / time.time() == pytest.approx(7.0, rel=1e-3)
     assert moos.local_time(apply_timewartping=False) == pytest.approx(time.time(), abs=1.0)
-    assert comms().clock is DEFAULT_CLOCK
-    assert make_comms("ours").clock is DEFAULT_CLOCK
+    assert comms().clock is pymoos_clock
+    assert choose_client("ours").comms.clock is pymoos_clock
     with pytest.raises(ValueError, match="outside"):
         moos.set_moos_timewarp(0)
 
 
-def test_the_default_clock_was_restored_after_the_previous_test():
-    assert DEFAULT_CLOCK.warp == 1.0 and DEFAULT_CLOCK.skew == 0.0
-
-
 def test_factory_passes_an_explicit_clock_to_our_client():
+    before = (DEFAULT_CLOCK.warp, DEFAULT_CLOCK.skew)
     own = MoosClock(3)
-    client = make_comms("ours", clock=own)
-    assert client.clock is own and comms(clock=own).clock is own
-    assert moos_time_source(client)() / time.time() == pytest.approx(3.0, rel=1e-3)
-    assert DEFAULT_CLOCK.warp == 1.0
+    chosen = choose_client("ours", clock=own)
+    assert chosen.kind == "ours" and chosen.comms.clock is own and comms(clock=own).clock is own
+    assert chosen.moos_time() / time.time() == pytest.approx(3.0, rel=1e-3)
+    assert (DEFAULT_CLOCK.warp, DEFAULT_CLOCK.skew) == before
 
 
 def test_factory_applies_an_explicit_clock_to_the_real_pymoos(monkeypatch):
@@ -50,20 +60,19 @@ def test_factory_applies_an_explicit_clock_to_the_real_pymoos(monkeypatch):
     class FakeComms:
         pass
 
-    FakeComms.__module__ = "pymoos"
     fake.comms = FakeComms
     fake.set_moos_timewarp = warps.append
     fake.time = lambda: 42.0
     monkeypatch.setitem(sys.modules, "pymoos", fake)
-    client = make_comms("pymoos", clock=MoosClock(5))
-    assert isinstance(client, FakeComms) and warps == [5.0]
-    assert moos_time_source(client)() == 42.0
-    make_comms("auto")  # without a clock the process-wide warp is left alone
+    chosen = choose_client("pymoos", clock=MoosClock(5))
+    assert isinstance(chosen.comms, FakeComms) and chosen.kind == "pymoos" and warps == [5.0]
+    assert chosen.moos_time() == 42.0
+    choose_client("auto")  # without a clock the process-wide warp is left alone
     assert warps == [5.0]
 
 
 @pytest.fixture
-def quiet_clients(our_db) -> Iterator[tuple[comms, comms, comms]]:
+def quiet_clients(our_db, pymoos_clock) -> Iterator[tuple[comms, comms, comms]]:
     """Three quiet clients (quiet ones apply the DB's skew even on this host) on our in-process DB (warp 1):
     one on a warp-10 clock, one on a warp-1 clock, one on the process-wide default clock."""
     clients = [comms(clock=MoosClock(10)), comms(clock=MoosClock(1)), comms()]
@@ -103,6 +112,7 @@ def test_clients_with_their_own_clocks_do_not_interfere(our_db, quiet_clients):
 
 def test_clients_on_dbs_with_different_warps_keep_separate_skews():
     """Two DBs (warp 1 and warp 20), one quiet client each on its own clock: each tracks its own DB."""
+    before = (DEFAULT_CLOCK.warp, DEFAULT_CLOCK.skew)
     with running_moosdb(warp=1) as slow_db, running_moosdb(warp=20) as fast_db:
         slow, fast = comms(clock=MoosClock()), comms(clock=MoosClock())
         try:
@@ -117,4 +127,4 @@ def test_clients_on_dbs_with_different_warps_keep_separate_skews():
         finally:
             slow.close(True)
             fast.close(True)
-    assert DEFAULT_CLOCK.warp == 1.0 and DEFAULT_CLOCK.skew == 0.0
+    assert (DEFAULT_CLOCK.warp, DEFAULT_CLOCK.skew) == before

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from gateway.moos import make_comms
+from gateway.moos import choose_client
 from gateway.moos.errors import MoosError
 from gateway.moos.factory import pymoos_available
 from gateway.moos.testing import collect_mail, connected_comms, stop_process
@@ -60,23 +60,25 @@ def test_the_same_pymoos_script_runs_with_either_import(module: str, db_port: in
         assert sorted(results["queued"] + [m[2] for m in mail if m[0] == "PY_Q"]) == [0.0, 1.0, 2.0]
 
 
-def test_make_comms_kinds(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_choose_client_kinds(monkeypatch: pytest.MonkeyPatch) -> None:
     from gateway.moos import comms
 
-    assert isinstance(make_comms("ours"), comms)
+    ours = choose_client("ours")
+    assert isinstance(ours.comms, comms) and ours.kind == "ours"
     monkeypatch.setenv("GOBY_MOOS_CLIENT", "ours")
-    assert isinstance(make_comms(), comms)
+    assert isinstance(choose_client().comms, comms)
     with pytest.raises(MoosError, match="unknown MOOS client kind"):
-        make_comms("bogus")
+        choose_client("bogus")
     if pymoos_available():
         import pymoos
 
-        assert isinstance(make_comms("pymoos"), pymoos.comms)
-        assert isinstance(make_comms("auto"), pymoos.comms)
+        for kind in ("pymoos", "auto"):
+            real = choose_client(kind)
+            assert isinstance(real.comms, pymoos.comms) and real.kind == "pymoos" and real.moos_time is pymoos.time
     else:
-        assert isinstance(make_comms("auto"), comms)
+        assert isinstance(choose_client("auto").comms, comms)
         with pytest.raises(MoosError, match="cannot be imported"):
-            make_comms("pymoos")
+            choose_client("pymoos")
 
 
 def _tool_or_skip(name: str) -> str:

@@ -200,9 +200,8 @@ def test_non_main_thread_uses_interprocess_with_callbacks_on_its_thread(broker: 
         worker = app.worker
     assert {t for _, t in worker.got} == {worker.ident}
     assert answers[0].a % 10 == 0
-    from gateway.goby.portal import process_registry
-
-    entries = {(e.layer, e.direction, e.group, e.scheme, e.type, e.thread) for e in process_registry.entries()}
+    registry = app.context.registry  # the application's own: nothing recorded process-wide
+    entries = {(e.layer, e.direction, e.group, e.scheme, e.type, e.thread) for e in registry.entries()}
     assert ("interprocess", "subscribe", "from_test", "PROTOBUF", "goby.test.zeromq.protobuf.Sample",
             "PortalThread") in entries
     assert ("interprocess", "publish", "from_thread", "PROTOBUF", "goby.test.zeromq.protobuf.Sample",

@@ -16,7 +16,7 @@ import time
 
 from google.protobuf import text_format
 
-from gateway.goby.portal import SingleThreadApplication, clock, run_application
+from gateway.goby.portal import SingleThreadApplication, run_application
 from translators.usv import groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
@@ -76,6 +76,7 @@ class CommandSender(SingleThreadApplication):
 
     def __init__(self, cfg: CommandTool, command: USVCommand, timeout_s: float) -> None:
         super().__init__(cfg, loop_frequency_hz=10.0)
+        command.time = self.context.clock.now()  # the application's clock: warped if app.simulation says so
         self._command = command
         self._deadline = time.monotonic() + timeout_s
         self._timeout_s = timeout_s
@@ -116,7 +117,6 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_REFUSED
 
     def make_app(cfg: CommandTool) -> CommandSender:
-        command.time = clock.now()  # stamped here: run_application has applied app.simulation (warp) by now
         timeout = args.timeout if args.timeout is not None else cfg.ack_timeout
         return CommandSender(cfg, command, timeout)
 

@@ -1,7 +1,9 @@
-"""What the threads of one process share: the ZeroMQ context, the interthread hub, the start-up hold and config.
+"""What the threads of one application share: the ZeroMQ context, the interthread hub, the start-up hold, the
+config, the clock and the interface registry.
 
 An application creates one ``ProcessContext`` and its threads find it through :func:`current_context` (set on each
-thread the application launches), so user thread classes need not pass it around.
+thread the application launches), so user thread classes need not pass it around.  Nothing here is module-level:
+two applications in one process (tests do this) have separate clocks and registries.
 """
 
 from __future__ import annotations
@@ -17,11 +19,10 @@ from typing import Any
 
 import zmq
 
-from gateway.goby.portal.interface_registry import InterfaceRegistry, process_registry
+from gateway.goby.portal.interface_registry import InterfaceRegistry
 from gateway.goby.portal.interthread import InterThread
 from gateway.goby.portal.mailbox import Mailbox
 from gateway.goby.portal.timeutil import SystemClock
-from gateway.goby.portal.timeutil import clock as process_clock
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 
 log = logging.getLogger(__name__)
@@ -33,7 +34,11 @@ DEFAULT_HOLD_SETTLE_S = 1.0
 
 
 class ProcessContext:
-    """Shared state of one process's portal threads; close it after every thread using it has closed."""
+    """Shared state of one application's portal threads; close it after every thread using it has closed.
+
+    ``clock``: the application's (possibly warped) clock, a real-time ``SystemClock`` unless given;
+    ``registry``: where every publish/subscribe call is recorded, a new one unless given.
+    """
 
     def __init__(
         self,
@@ -51,8 +56,8 @@ class ProcessContext:
             self.client_name = self.interprocess_cfg.client_name
         else:
             self.client_name = client_name or self.application
-        self.clock = clock if clock is not None else process_clock
-        self.registry = registry if registry is not None else process_registry
+        self.clock = clock if clock is not None else SystemClock()
+        self.registry = registry if registry is not None else InterfaceRegistry()
         self.hold_settle_s = hold_settle_s
         self.interthread = InterThread()
         self.ready_flag = False

@@ -1,8 +1,8 @@
 """A per-process record of every publish/subscribe call, for the interface-file tool.
 
-Each distinct (layer, direction, group, scheme, type, thread) is recorded once.  Read it in-process with
-``process_registry.entries()``, or set ``GOBY_INTERFACE_REGISTRY=<path>`` and applications write it as JSON
-when they exit (see docs/portal.md).
+Each distinct (layer, direction, group, scheme, type, thread) is recorded once.  Every application records into
+its own registry (``ProcessContext.registry``): read it in-process with ``context.registry.entries()``, or set
+``GOBY_INTERFACE_REGISTRY=<path>`` and applications write it as JSON when they exit (see docs/portal.md).
 """
 
 from __future__ import annotations
@@ -82,6 +82,3 @@ def read_entries(path: str | os.PathLike[str]) -> list[InterfaceEntry]:
     """Entries written by :meth:`InterfaceRegistry.write`."""
     return [InterfaceEntry(**item) for item in json.loads(Path(path).read_text())]
 
-
-#: The registry every portal in this process records into.
-process_registry = InterfaceRegistry()

@@ -18,7 +18,7 @@ from google.protobuf import message as pb_message
 
 from gateway.goby.portal.errors import ClosedError
 from gateway.goby.portal.group import GroupLike, as_group, check_named
-from gateway.goby.portal.interface_registry import InterfaceEntry, InterfaceRegistry, process_registry
+from gateway.goby.portal.interface_registry import InterfaceEntry, InterfaceRegistry
 from gateway.goby.portal.mailbox import Mailbox
 from gateway.goby.portal.marshalling import Scheme
 
@@ -114,13 +114,12 @@ class InterThreadTransporter:
     """One thread's handle on the interthread layer; every method must be called from the owning thread."""
 
     def __init__(
-        self, hub: InterThread, mailbox: Mailbox, thread_name: str, registry: InterfaceRegistry | None = None,
-        application: str = "",
+        self, hub: InterThread, mailbox: Mailbox, thread_name: str, registry: InterfaceRegistry, application: str = "",
     ) -> None:
         self._hub = hub
         self._mailbox = mailbox
         self._thread_name = thread_name
-        self._registry = registry if registry is not None else process_registry
+        self._registry = registry
         self._application = application
         self._recorded: set[tuple[str, str, str]] = set()
 

@@ -29,10 +29,10 @@ def _div_toward_zero(value: int, divisor: int) -> int:
 
 
 class SystemClock:
-    """The process clock; ``configure`` applies ``app.simulation.time`` (Goby's ``SimulatorSettings``).
+    """An application's clock; ``configure`` applies ``app.simulation.time`` (Goby's ``SimulatorSettings``).
 
-    One instance (``gateway.goby.portal.clock``) serves the whole process, as Goby's statics do; tests may build
-    their own instance.
+    Goby keeps this in statics; here each application owns one (``ProcessContext.clock``, configured by
+    ``run_application``), so two applications in one process never change each other's time.
     """
 
     def __init__(self, use_sim_time: bool = False, warp_factor: int = 1, reference_micro: int | None = None) -> None:
@@ -140,6 +140,3 @@ def file_str(micro: int) -> str:
     assert when is not None
     return when.strftime("%Y%m%dT%H%M%S")
 
-
-#: The process-wide clock applications configure from ``app.simulation.time``.
-clock = SystemClock()
