@@ -14,7 +14,7 @@ import logging
 import math
 
 from frontseat.driver import Clock, FrontSeatDriver
-from frontseat.errors import ConfigError
+from frontseat.errors import DriverConfigError, SimulatorLineError
 from frontseat.line_client import LineClient
 from frontseat.protobuf import basic_simulator_config_pb2 as sim_pb
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
@@ -40,12 +40,12 @@ class BasicSimulatorDriver(FrontSeatDriver):
     def __init__(self, cfg: config_pb.Config, *, clock: Clock | None = None) -> None:
         super().__init__(cfg, clock=clock)
         if not cfg.HasExtension(CONFIG_EXTENSION):
-            raise ConfigError(f"frontseat_cfg has no [{EXTENSION_NAME}] block; the basic simulator driver needs one")
+            raise DriverConfigError(f"frontseat_cfg has no [{EXTENSION_NAME}] block; the basic simulator driver needs one")
         self.sim_cfg = sim_pb.BasicSimulatorFrontSeatConfig()
         self.sim_cfg.CopyFrom(cfg.Extensions[CONFIG_EXTENSION])
         missing = self.sim_cfg.FindInitializationErrors()
         if missing:
-            raise ConfigError(f"[{EXTENSION_NAME}] is missing required field(s): {', '.join(missing)}")
+            raise DriverConfigError(f"[{EXTENSION_NAME}] is missing required field(s): {', '.join(missing)}")
         self._fs_state = fs_pb.FRONTSEAT_NOT_CONNECTED
         self._providing_data = False
         self._last_data_time = -math.inf
@@ -129,7 +129,7 @@ class BasicSimulatorDriver(FrontSeatDriver):
         self.signal_raw_from_frontseat.emit(fs_pb.Raw(raw=line.encode()))
         try:
             key, fields = protocol.parse_line(line)
-        except protocol.ProtocolError as exc:
+        except SimulatorLineError as exc:
             log.warning("failed to handle message from the frontseat %r: %s", line, exc)
             return
         if key == "CTRL":

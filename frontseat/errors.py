@@ -29,9 +29,9 @@ class FrontSeatErrorException(FrontSeatException):
         super().__init__(fs_pb.FrontSeatError.Name(frontseat_error))
 
 
-class DriverLoadError(FrontSeatException):
-    """The driver library named by ``FRONTSEAT_DRIVER_LIBRARY`` could not be loaded or used."""
+class SimulatorLineError(FrontSeatException, ValueError):
+    """A basic-simulator protocol line that is malformed or cannot be acted on; the message names the cause."""
 
 
-class ConfigError(FrontSeatException):
+class DriverConfigError(FrontSeatException):
     """A configuration value is missing or out of range."""

@@ -13,7 +13,7 @@ import sys
 from collections.abc import Mapping
 from pathlib import Path
 
-from launch.errors import ConfigError
+from launch.errors import MissionConfigError
 
 INVALID_BANNER = "=============== INVALID CONFIGURATION ================="
 
@@ -24,13 +24,13 @@ def render(template: str | Path, values: Mapping[str, object]) -> str:
     try:
         text = path.read_text()
     except OSError as exc:
-        raise ConfigError(f"cannot read template {path}: {exc.strerror or exc}") from exc
+        raise MissionConfigError(f"cannot read template {path}: {exc.strerror or exc}") from exc
     try:
         return string.Template(text).substitute({k: str(v) for k, v in values.items()})
     except KeyError as exc:
-        raise ConfigError(f"template {path.name} needs a value for ${exc.args[0]}") from exc
+        raise MissionConfigError(f"template {path.name} needs a value for ${exc.args[0]}") from exc
     except ValueError as exc:
-        raise ConfigError(f"template {path.name}: {exc}") from exc
+        raise MissionConfigError(f"template {path.name}: {exc}") from exc
 
 
 def fail(message: str) -> int:

@@ -21,5 +21,5 @@ class ProcessDiedError(LaunchError):
         super().__init__(f"process {name!r} died (exit status {returncode}); last lines of its log:\n{log_tail}")
 
 
-class ConfigError(LaunchError):
+class MissionConfigError(LaunchError):
     """A mission configuration is invalid (a missing setting, an unknown app name)."""

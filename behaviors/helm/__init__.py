@@ -7,8 +7,8 @@ MOOSDB. See docs/helm.md.
 from __future__ import annotations
 
 from .config import HelmConfig, config_from_mission
-from .errors import BehaviorFileError, ConditionError, HelmError, ParamError
+from .errors import BehaviorFileError, ConditionError, IvPHelmError, ParamError
 from .helm import Helm, Post
 
-__all__ = ["BehaviorFileError", "ConditionError", "Helm", "HelmConfig", "HelmError", "ParamError", "Post",
+__all__ = ["BehaviorFileError", "ConditionError", "Helm", "HelmConfig", "IvPHelmError", "ParamError", "Post",
            "config_from_mission"]

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 
-class HelmError(Exception):
+class IvPHelmError(Exception):
     """Root of every error the helm raises."""
 
 
-class BehaviorFileError(HelmError):
+class BehaviorFileError(IvPHelmError):
     """A .bhv file (or a helm config line) that cannot be used; names the file, the line and the token."""
 
     def __init__(self, path: str, line: int, token: str, reason: str) -> None:
@@ -15,7 +15,7 @@ class BehaviorFileError(HelmError):
         super().__init__(f"{path}:{line}: {reason} (at '{token}')")
 
 
-class ParamError(HelmError):
+class ParamError(IvPHelmError):
     """A behaviour or helm parameter with a bad value; the caller adds file and line."""
 
 
@@ -23,7 +23,7 @@ class UnknownParamError(ParamError):
     """A parameter name the behaviour (or the helm) does not have."""
 
 
-class ConditionError(HelmError):
+class ConditionError(IvPHelmError):
     """A logic condition that does not parse; ``token`` is the offending part."""
 
     def __init__(self, text: str, token: str, reason: str) -> None:

@@ -11,8 +11,9 @@ import logging
 import math
 from dataclasses import dataclass, field, replace
 
+from frontseat.errors import SimulatorLineError
 from frontseat.simulator import protocol
-from frontseat.simulator.protocol import INT_MAX, ProtocolError
+from frontseat.simulator.protocol import INT_MAX
 from util.geodesy import UTMGeodesy
 
 log = logging.getLogger(__name__)
@@ -53,10 +54,6 @@ class Kinematics:
     hdg: float = 0.0
 
 
-class BadLine(ValueError):
-    """A line the simulator cannot act on; the message names the cause."""
-
-
 def _approach(value: float, target: float, step: float) -> float:
     """Move ``value`` toward ``target`` by ``step``, landing on it when closer than ``step``."""
     if abs(value - target) > step:
@@ -79,20 +76,20 @@ def step_dynamics(vehicle: Kinematics, desired: Kinematics, cfg: VehicleConfig, 
 
 
 def parse_start(fields: dict[str, str]) -> StartParams:
-    """START fields -> parameters. Raises :class:`BadLine` naming the first bad field."""
+    """START fields -> parameters. Raises :class:`SimulatorLineError` naming the first bad field."""
     for name in ("LAT", "LON"):
         if name not in fields:
-            raise BadLine(f"Invalid START: missing {name} field")
+            raise SimulatorLineError(f"Invalid START: missing {name} field")
     lat, lon = protocol.as_double(fields["LAT"]), protocol.as_double(fields["LON"])
     if not (-90 <= lat <= 90 and -180 <= lon <= 180):
-        raise BadLine(f"Invalid START: LAT/LON {fields['LAT']!r}/{fields['LON']!r} is not a position")
+        raise SimulatorLineError(f"Invalid START: LAT/LON {fields['LAT']!r}/{fields['LON']!r} is not a position")
 
     def integer(name: str, default: int, low: int, high: int) -> int:
         if name not in fields:
             return default
         value = protocol.as_int(fields[name]) if protocol.is_int(fields[name]) else None
         if value is None or not low <= value <= high:
-            raise BadLine(f"Invalid START: {name} {fields[name]!r} must be an integer in {low}..{high}")
+            raise SimulatorLineError(f"Invalid START: {name} {fields[name]!r} must be an integer in {low}..{high}")
         return value
 
     def real(name: str, default: float) -> float:
@@ -100,7 +97,7 @@ def parse_start(fields: dict[str, str]) -> StartParams:
             return default
         value = protocol.as_double(fields[name])
         if not (math.isfinite(value) and value >= 0):
-            raise BadLine(f"Invalid START: {name} {fields[name]!r} must be a finite number >= 0")
+            raise SimulatorLineError(f"Invalid START: {name} {fields[name]!r} must be a finite number >= 0")
         return value
 
     defaults = VehicleConfig()
@@ -119,14 +116,14 @@ def parse_start(fields: dict[str, str]) -> StartParams:
 
 
 def parse_command(fields: dict[str, str]) -> tuple[float, float, float]:
-    """CMD fields -> (heading, speed, depth). Raises :class:`BadLine` for a missing or non-numeric value."""
+    """CMD fields -> (heading, speed, depth). Raises :class:`SimulatorLineError` for a missing or non-numeric value."""
     values = []
     for name in ("HEADING", "SPEED", "DEPTH"):
         if name not in fields:
-            raise BadLine(f"Invalid CMD: missing {name} field")
+            raise SimulatorLineError(f"Invalid CMD: missing {name} field")
         value = protocol.as_double(fields[name])
         if not math.isfinite(value):
-            raise BadLine(f"Invalid CMD: {name} {fields[name]!r} is not a finite number")
+            raise SimulatorLineError(f"Invalid CMD: {name} {fields[name]!r} is not a finite number")
         values.append(value)
     return values[0], values[1], values[2]
 
@@ -162,19 +159,19 @@ class Simulation:
         try:
             try:
                 _, fields = protocol.parse_line(line)
-            except ProtocolError as exc:
-                raise BadLine(f"Invalid line: {exc}") from exc
+            except SimulatorLineError as exc:
+                raise SimulatorLineError(f"Invalid line: {exc}") from exc
             if key == "CMD":
                 if not self.started:
-                    raise BadLine("CMD before START (or after DURATION ran out)")
+                    raise SimulatorLineError("CMD before START (or after DURATION ran out)")
                 self._apply_command(fields)
                 return [protocol.CMD_OK]
             if key == "START":
                 self._apply_start(parse_start(fields))
                 log.info("Initialized using: %s", line)
                 return [protocol.CTRL_PAYLOAD]
-            raise BadLine(f"Unknown key {key!r}")
-        except BadLine as exc:
+            raise SimulatorLineError(f"Unknown key {key!r}")
+        except SimulatorLineError as exc:
             log.warning("rejected line from payload %r: %s", _shorten(line), exc)
             return [protocol.CMD_ERROR] if key == "CMD" else []
 

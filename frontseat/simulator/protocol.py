@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 import re
 
+from frontseat.errors import SimulatorLineError
+
 DELIMITER = b"\r\n"
 INT_MAX = 2**31 - 1
 INT_MIN = -(2**31)
@@ -23,10 +25,6 @@ _DOUBLE = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)
 _INT = re.compile(r"[+-]?\d+")
 
 
-class ProtocolError(ValueError):
-    """A line that cannot be split into fields."""
-
-
 def line_key(line: str) -> str:
     """The first comma-separated token (the message type), even for a line whose fields are malformed."""
     return line.split(",", 1)[0]
@@ -35,7 +33,7 @@ def line_key(line: str) -> str:
 def parse_line(line: str) -> tuple[str, dict[str, str]]:
     """Split ``KEY,A:1,B:2`` into ``("KEY", {"A": "1", "B": "2"})``.
 
-    Parts of a field after a second ``:`` are ignored. Raises :class:`ProtocolError` for a field with no
+    Parts of a field after a second ``:`` are ignored. Raises :class:`SimulatorLineError` for a field with no
     ``:`` (including the empty field of ``,,`` or of a trailing comma).
     """
     key, *tokens = line.split(",")
@@ -43,7 +41,7 @@ def parse_line(line: str) -> tuple[str, dict[str, str]]:
     for token in tokens:
         name, sep, rest = token.partition(":")
         if not sep:
-            raise ProtocolError(f"field {token!r} has no ':'")
+            raise SimulatorLineError(f"field {token!r} has no ':'")
         fields.setdefault(name, rest.split(":", 1)[0])
     return key, fields
 

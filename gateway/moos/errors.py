@@ -2,15 +2,24 @@
 
 from __future__ import annotations
 
+from typing import Any
 
-class MoosError(Exception):
+from gateway.errors import GatewayError
+
+
+class MoosError(GatewayError):
     """Root of every error raised by ``gateway.moos``."""
 
 
 class ProtocolError(MoosError):
-    """Bytes on the wire do not form a valid MOOS v10 packet or message."""
+    """Bytes on the wire do not form a valid MOOS v10 packet or message.
 
-    packets: list = []  # set by PacketReader.feed: whole packets decoded before the error
+    ``packets``: the whole packets ``PacketReader.feed`` decoded before the bad bytes (each error its own list).
+    """
+
+    def __init__(self, message: str, packets: list[Any] | None = None) -> None:
+        super().__init__(message)
+        self.packets: list[Any] = list(packets) if packets is not None else []
 
 
 class HandshakeError(MoosError):

@@ -23,6 +23,7 @@ from types import ModuleType
 
 from google.protobuf.message import Message
 
+from launch.errors import LaunchError
 from launch.interfaces.model import ApplicationInterface, PubSubEntry, ThreadInfo
 
 log = logging.getLogger(__name__)
@@ -33,7 +34,7 @@ EXCLUDED_PACKAGES = ("gateway.goby.portal", "launch.interfaces", "gateway.moos")
 LAYER_METHODS = {"interprocess": "interprocess", "interthread": "interthread"}
 
 
-class AnalysisError(Exception):
+class AnalysisError(LaunchError):
     """A publish/subscribe call whose group, type or layer cannot be determined; names file and line."""
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import yaml
 
+from launch.errors import LaunchError
 from launch.interfaces.interface_yaml import InterfaceFileError, load
 from launch.interfaces.model import ApplicationInterface
 
@@ -19,7 +20,7 @@ INTERFACES_DIR_TOKEN = "@GOBY_INTERFACES_DIR@"
 DEFAULT_INTERFACES_DIR = Path(__file__).resolve().parents[2] / "docs" / "interfaces"
 
 
-class DeploymentError(ValueError):
+class DeploymentError(LaunchError, ValueError):
     """A deployment file that cannot be used; the message names the file and the problem."""
 
 

@@ -10,10 +10,11 @@ from pathlib import Path
 
 import yaml
 
+from launch.errors import LaunchError
 from launch.interfaces.model import LAYERS, ApplicationInterface, PubSubEntry, ThreadInfo
 
 
-class InterfaceFileError(ValueError):
+class InterfaceFileError(LaunchError, ValueError):
     """An interface YAML file that cannot be understood; the message names the file and the problem."""
 
 

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from launch.config import fail, render
-from launch.errors import ConfigError
+from launch.errors import MissionConfigError
 from launch.usv.settings import USV_DIR, UsvSettings
 
 TEMPLATES = USV_DIR / "templates"
@@ -67,7 +67,7 @@ def write_moos_file(settings: UsvSettings) -> Path:
 
 def _moos(settings: UsvSettings) -> str:
     if not settings.bhv_file.is_file():
-        raise ConfigError(f"behaviour file {settings.bhv_file} does not exist (USV_BHV_FILE)")
+        raise MissionConfigError(f"behaviour file {settings.bhv_file} does not exist (USV_BHV_FILE)")
     return str(write_moos_file(settings))
 
 
@@ -84,17 +84,17 @@ GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
 
 
 def generate(app: str, settings: UsvSettings) -> str:
-    """One app's configuration text; ConfigError for an unknown app or a bad setting."""
+    """One app's configuration text; MissionConfigError for an unknown app or a bad setting."""
     try:
         generator = GENERATORS[app]
     except KeyError:
-        raise ConfigError(f"App: {app} not defined (known: {', '.join(sorted(GENERATORS))})") from None
+        raise MissionConfigError(f"App: {app} not defined (known: {', '.join(sorted(GENERATORS))})") from None
     # The run directory holds the broker's sockets and the .moos file: make sure it exists whichever app comes first.
     try:
         settings.run_dir.mkdir(parents=True, exist_ok=True)
         Path(settings.ipc_base).parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise ConfigError(f"cannot create the run directory {settings.run_dir}: {exc.strerror or exc}") from exc
+        raise MissionConfigError(f"cannot create the run directory {settings.run_dir}: {exc.strerror or exc}") from exc
     return generator(settings)
 
 
@@ -104,7 +104,7 @@ def main(argv: list[str] | None = None) -> int:
         return fail(f"usage: python -m launch.usv.config APP   (APP one of {', '.join(sorted(GENERATORS))})")
     try:
         text = generate(args[0], UsvSettings.from_env())
-    except ConfigError as exc:
+    except MissionConfigError as exc:
         return fail(str(exc))
     print(text, flush=True)
     return 0

@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 
 from launch.config import free_tcp_port
-from launch.errors import ConfigError, LaunchError
+from launch.errors import LaunchError, MissionConfigError
 from launch.usv.analysis import bhv_waypoints, command_effects, loiter_phases, transitions
 from launch.usv.mission import MissionResult, UsvMission, choose_program
 from launch.usv.plot import write_track_png
@@ -65,7 +65,7 @@ def _schedule(text: str) -> str:
     """The shore's own parser, so a schedule the shore would refuse is refused before anything starts."""
     try:
         parse_schedule(text)
-    except ConfigError as exc:
+    except MissionConfigError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
     return text
 

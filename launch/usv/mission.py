@@ -15,7 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from launch.errors import ConfigError, LaunchError, ProcessDiedError
+from launch.errors import LaunchError, MissionConfigError, ProcessDiedError
 from launch.launcher import child_environment
 from launch.launchfile import parse_file
 from launch.process_group import ManagedProcess, ProcessGroup
@@ -39,10 +39,10 @@ def choose_program(choice: str, real: str, ours: str) -> str:
     found = shutil.which(real)
     if choice == "real":
         if not found:
-            raise ConfigError(f"{real} was asked for but is not on PATH")
+            raise MissionConfigError(f"{real} was asked for but is not on PATH")
         return real
     if choice != "auto":
-        raise ConfigError(f"choose auto, real or ours, not {choice!r}")
+        raise MissionConfigError(f"choose auto, real or ours, not {choice!r}")
     return real if found else ours
 
 

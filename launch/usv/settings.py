@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from launch.errors import ConfigError
+from launch.errors import MissionConfigError
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 USV_DIR = Path(__file__).resolve().parent
@@ -63,13 +63,13 @@ class UsvSettings:
 
     def __post_init__(self) -> None:
         if self.warp < 1:
-            raise ConfigError(f"warp must be a whole number >= 1, not {self.warp}")
+            raise MissionConfigError(f"warp must be a whole number >= 1, not {self.warp}")
         for port_name in ("moos_port", "sim_port"):
             port = getattr(self, port_name)
             if not 0 < port < 65536:
-                raise ConfigError(f"{port_name} {port} is not a TCP port")
+                raise MissionConfigError(f"{port_name} {port} is not a TCP port")
         if not -90 <= self.lat_origin <= 90 or not -180 <= self.lon_origin <= 180:
-            raise ConfigError(f"origin {self.lat_origin},{self.lon_origin} is not a latitude,longitude")
+            raise MissionConfigError(f"origin {self.lat_origin},{self.lon_origin} is not a latitude,longitude")
 
     @property
     def ipc_base(self) -> str:
@@ -99,7 +99,7 @@ class UsvSettings:
 
     @classmethod
     def from_env(cls, environ: Mapping[str, str] | None = None) -> UsvSettings:
-        """Settings from ``USV_*`` variables; unset ones keep the defaults. Bad values raise ConfigError."""
+        """Settings from ``USV_*`` variables; unset ones keep the defaults. Bad values raise MissionConfigError."""
         environ = os.environ if environ is None else environ
         kwargs: dict[str, object] = {}
         types = {f.name: f.type for f in dataclasses.fields(cls)}
@@ -118,7 +118,7 @@ class UsvSettings:
                 else:
                     kwargs[field] = raw
             except ValueError as exc:
-                raise ConfigError(f"{var}={raw!r} is not a valid {kind}") from exc
+                raise MissionConfigError(f"{var}={raw!r} is not a valid {kind}") from exc
         return cls(**kwargs)  # type: ignore[arg-type]
 
     def replace(self, **changes: object) -> UsvSettings:

@@ -26,8 +26,8 @@ from google.protobuf import text_format
 
 from frontseat import groups as frontseat_groups
 from frontseat.protobuf.frontseat_pb2 import INTERFACE_COMMAND, InterfaceStatus
-from gateway.goby.portal import SingleThreadApplication, clock, run_application
-from launch.errors import ConfigError
+from gateway.goby.portal import SingleThreadApplication, run_application
+from launch.errors import MissionConfigError
 from launch.usv.settings import DEFAULT_SCHEDULE
 from translators.apps.usv_command import describe_ack
 from translators.usv import groups as usv_groups
@@ -67,7 +67,7 @@ SCHEDULE_HELP = f"T:waypoints / T:polygon:SIDES:RADIUS, comma-separated, T in si
 
 
 def parse_schedule(text: str) -> list[ScheduledCommand]:
-    """Parse ``0:polygon:6:200,500:waypoints`` (or ``none``: no commands); ConfigError names the bad entry.
+    """Parse ``0:polygon:6:200,500:waypoints`` (or ``none``: no commands); MissionConfigError names the bad entry.
 
     Every command is also checked against the USVCommand's DCCL bounds, so a plan that could not be sent
     is refused before anything starts.
@@ -75,11 +75,11 @@ def parse_schedule(text: str) -> list[ScheduledCommand]:
     if text.strip().lower() == NO_SCHEDULE:
         return []
     if not text.strip():
-        raise ConfigError(f"empty schedule {text!r}: give {SCHEDULE_HELP}")
+        raise MissionConfigError(f"empty schedule {text!r}: give {SCHEDULE_HELP}")
     plan = []
     for item in (part.strip() for part in text.split(",")):
         if not item:
-            raise ConfigError(f"empty entry in schedule {text!r} (two commas, or one at an end)")
+            raise MissionConfigError(f"empty entry in schedule {text!r} (two commas, or one at an end)")
         fields = item.split(":")
         try:
             at = float(fields[0])
@@ -91,16 +91,16 @@ def parse_schedule(text: str) -> list[ScheduledCommand]:
             else:
                 raise ValueError(item)
         except (ValueError, IndexError):
-            raise ConfigError(
+            raise MissionConfigError(
                 f"bad schedule entry {item!r}: use T:waypoints or T:polygon:SIDES:RADIUS (T in sim seconds)"
             ) from None
         if not math.isfinite(at) or at < 0:
-            raise ConfigError(f"bad schedule entry {item!r}: time must be a number >= 0")
+            raise MissionConfigError(f"bad schedule entry {item!r}: time must be a number >= 0")
         command = ScheduledCommand(at, args)
         try:
             check_dccl_bounds(command.to_message(0.0))
         except DcclBoundsError as error:
-            raise ConfigError(f"bad schedule entry {item!r}: {error}") from None
+            raise MissionConfigError(f"bad schedule entry {item!r}: {error}") from None
         plan.append(command)
     return sorted(plan, key=lambda c: c.at)
 
@@ -145,7 +145,7 @@ class ShoreOperator(SingleThreadApplication):
         while self._t0 is not None and self._plan and self._plan[0].at <= self._sim_elapsed():
             planned: ScheduledCommand = self._plan.pop(0)
             try:
-                message = check_dccl_bounds(planned.to_message(clock.now()))
+                message = check_dccl_bounds(planned.to_message(self.context.clock.now()))
             except DcclBoundsError as error:
                 log.error("not sending %s: %s", planned.describe(), error)
                 continue
@@ -164,7 +164,7 @@ def main(argv: list[str] | None = None) -> int:
     args, goby_argv = parser.parse_known_args(argv)
     try:
         plan = parse_schedule(args.schedule)
-    except ConfigError as exc:
+    except MissionConfigError as exc:
         print(f"{PROG}: {exc}", file=sys.stderr)
         return 2
     return run_application(lambda cfg: ShoreOperator(cfg, plan), CommandTool, goby_argv, prog=PROG)

@@ -9,7 +9,7 @@ import time
 import pytest
 
 from frontseat.basic_simulator_driver import BasicSimulatorDriver, frontseat_driver_load
-from frontseat.errors import ConfigError
+from frontseat.errors import DriverConfigError
 from frontseat.protobuf import basic_simulator_config_pb2 as sim_pb
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_pb2 as fs
@@ -63,7 +63,7 @@ def tick_until(driver: BasicSimulatorDriver, condition, timeout: float = 20.0, w
 
 
 def test_missing_extension_is_a_clear_config_error() -> None:
-    with pytest.raises(ConfigError, match="basic_simulator_config"):
+    with pytest.raises(DriverConfigError, match="basic_simulator_config"):
         frontseat_driver_load(config_pb.Config())
 
 

@@ -8,6 +8,7 @@ import time
 
 import pytest
 
+from frontseat.errors import SimulatorLineError
 from frontseat.simulator import protocol
 from frontseat.simulator.model import Simulation
 from frontseat.simulator.server import SimulatorServer
@@ -65,7 +66,7 @@ def test_parse_line_first_duplicate_wins_and_extra_colon_parts_are_ignored() -> 
 
 @pytest.mark.parametrize("line", ["CMD,HEADING:1,", "CMD,,HEADING:1", "CMD,HEADING"])
 def test_parse_line_rejects_a_field_without_colon(line: str) -> None:
-    with pytest.raises(protocol.ProtocolError):
+    with pytest.raises(SimulatorLineError):
         protocol.parse_line(line)
 
 

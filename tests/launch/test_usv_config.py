@@ -14,7 +14,7 @@ from frontseat.protobuf.frontseat_interface_config_pb2 import FrontSeatInterface
 from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
 from gateway.moos.mission_file import MissionFile
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
-from launch.errors import ConfigError
+from launch.errors import MissionConfigError
 from launch.launchfile import parse_file
 from launch.usv.config import GENERATORS, generate, write_moos_file
 from launch.usv.demo import command_env, command_lines
@@ -72,9 +72,9 @@ def test_moos_file_matches_the_goby_side(settings):
 
 def test_settings_round_trip_through_the_environment(settings):
     assert UsvSettings.from_env(settings.to_env()) == settings
-    with pytest.raises(ConfigError, match="USV_WARP='fast' is not a valid int"):
+    with pytest.raises(MissionConfigError, match="USV_WARP='fast' is not a valid int"):
         UsvSettings.from_env({"USV_WARP": "fast"})
-    with pytest.raises(ConfigError, match="warp must be"):
+    with pytest.raises(MissionConfigError, match="warp must be"):
         UsvSettings(warp=0)
 
 
@@ -111,17 +111,17 @@ def test_schedule_parsing():
     ]
     for bad in ("x:waypoints", "10:polygon:6", "10:circle", "-5:waypoints", "10:loiter", "nan:waypoints",
                 "0:polygon:2:200", "0:polygon:6:5000"):  # the last two are outside the USVCommand's DCCL bounds
-        with pytest.raises(ConfigError, match="bad schedule entry"):
+        with pytest.raises(MissionConfigError, match="bad schedule entry"):
             parse_schedule(bad)
 
 
 def test_an_explicitly_empty_schedule_is_none_and_blank_ones_are_refused():
     assert parse_schedule("none") == [] and parse_schedule(" None ") == []
     for blank in ("", " "):
-        with pytest.raises(ConfigError, match="empty schedule .* none for no commands"):
+        with pytest.raises(MissionConfigError, match="empty schedule .* none for no commands"):
             parse_schedule(blank)
     for gap in ("0:waypoints,,500:waypoints", "0:waypoints,"):
-        with pytest.raises(ConfigError, match="empty entry"):
+        with pytest.raises(MissionConfigError, match="empty entry"):
             parse_schedule(gap)
 
 
@@ -139,7 +139,7 @@ def test_choosing_real_or_our_programs(monkeypatch):
     monkeypatch.setenv("PATH", "/nonexistent")
     assert choose_program("auto", "MOOSDB", "moos-db") == "moos-db"
     assert choose_program("ours", "MOOSDB", "moos-db") == "moos-db"
-    with pytest.raises(ConfigError, match="MOOSDB was asked for but is not on PATH"):
+    with pytest.raises(MissionConfigError, match="MOOSDB was asked for but is not on PATH"):
         choose_program("real", "MOOSDB", "moos-db")
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from google.protobuf import text_format
 
-from gateway.goby.portal import ConfigError
+from gateway.goby.portal import AppConfigError
 from gateway.goby.portal.config import example_config, load_config
 from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
@@ -62,13 +62,13 @@ def test_glog_tty_verbosity_and_app_name_flag() -> None:
     ],
 )
 def test_bad_config_is_a_named_error(args: list[str], message: str) -> None:
-    with pytest.raises(ConfigError, match=message):
+    with pytest.raises(AppConfigError, match=message):
         load_config(SampleAppConfig, args, environ={})
 
 
 def test_bad_file_names_file_and_line(tmp_path: Path) -> None:
     path = _write(tmp_path, "app {\n  nmae: 1\n}\n")
-    with pytest.raises(ConfigError, match=r"app.pb.cfg: 2:"):
+    with pytest.raises(AppConfigError, match=r"app.pb.cfg: 2:"):
         load_config(SampleAppConfig, [path], environ={})
 
 

@@ -10,6 +10,7 @@ from collections.abc import MutableMapping
 from frontseat.protobuf.frontseat_data_pb2 import DesiredCourse
 from frontseat.protobuf.frontseat_pb2 import HELM_DRIVE, HELM_NOT_RUNNING, HELM_PARK, HelmState
 from gateway.moos.message import MoosMessage
+from translators.errors import TranslatorError
 
 DESIRED_SPEED = "DESIRED_SPEED"
 IVPHELM_STATE = "IVPHELM_STATE"
@@ -36,7 +37,7 @@ BUFFERED_SETPOINTS: tuple[str, ...] = (
 )
 
 
-class SetpointError(ValueError):
+class SetpointError(TranslatorError, ValueError):
     """A DESIRED_* message that cannot be a setpoint (for example a string where a number belongs)."""
 
 

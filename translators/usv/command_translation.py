@@ -11,9 +11,9 @@ import logging
 
 from google.protobuf import text_format
 
-from gateway.goby.portal import MultiThreadApplication
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
-from translators.base import Translator
+from translators.base import Translator, translator_plugin
+from translators.errors import TranslatorError
 from translators.usv import groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
@@ -22,7 +22,7 @@ from translators.usv.validation import DcclBoundsError, check_dccl_bounds
 log = logging.getLogger(__name__)
 
 
-class CommandRefused(ValueError):
+class CommandRefusedError(TranslatorError, ValueError):
     """A USVCommand that must not reach the helm (out of DCCL bounds, or a polygon without its shape)."""
 
 
@@ -36,13 +36,13 @@ def command_posts(command: USVCommand) -> list[tuple[str, str]]:
     try:
         command = check_dccl_bounds(command)
     except DcclBoundsError as error:
-        raise CommandRefused(str(error)) from error
+        raise CommandRefusedError(str(error)) from error
     state = USVCommand.AutonomyState.Name(command.desired_state)
     posts: list[tuple[str, str]] = []
     if command.desired_state == USVCommand.POLYGON:
         missing = [f for f in ("polygon_sides", "polygon_radius") if not command.HasField(f)]
         if missing:
-            raise CommandRefused(f"POLYGON command without {' and '.join(missing)}")
+            raise CommandRefusedError(f"POLYGON command without {' and '.join(missing)}")
         update = f"polygon=radial::x=0,y=0,radius={command.polygon_radius},pts={command.polygon_sides}"
         posts.append(("POLYGON_UPDATES", update))
     posts.append(("DEPLOY_STATE", state))
@@ -65,7 +65,7 @@ class CommandTranslation(Translator):
             ack.command_time = command.time
         try:
             posts = command_posts(command)
-        except CommandRefused as error:
+        except CommandRefusedError as error:
             log.error("refusing USVCommand %s: %s", ack.command, error)
             ack.stage = USVCommandAck.REFUSED
             ack.error = str(error)
@@ -79,11 +79,5 @@ class CommandTranslation(Translator):
         self.goby().interprocess().publish(groups.usv_command_ack, ack)
 
 
-def load(gateway: MultiThreadApplication) -> None:
-    """Plugin entry: launch the translator thread. Runs on the gateway's main thread."""
-    gateway.launch_thread(CommandTranslation)
-
-
-def unload(gateway: MultiThreadApplication) -> None:
-    """Plugin exit: join the translator thread. Runs on the gateway's main thread."""
-    gateway.join_thread(CommandTranslation)
+# The plugin (``GOBY_MOOS_GATEWAY_PLUGINS``): load launches the translator, unload joins it.
+load, unload = translator_plugin(CommandTranslation)

@@ -16,6 +16,7 @@ from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
 from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as dccl_options
+from translators.errors import TranslatorError
 
 _DEFAULT_CODECS = {"dccl.default2", "dccl.default3", "dccl.default4"}
 _NUMERIC_TYPES = {
@@ -34,7 +35,7 @@ _NUMERIC_TYPES = {
 }
 
 
-class DcclBoundsError(ValueError):
+class DcclBoundsError(TranslatorError, ValueError):
     """A message that DCCL could not carry as given: a field outside its bounds, or a required field unset."""
 
 

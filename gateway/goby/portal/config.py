@@ -18,7 +18,7 @@ from google.protobuf import descriptor as pb_descriptor
 from google.protobuf import message as pb_message
 from google.protobuf import text_format
 
-from gateway.goby.portal.errors import ConfigError
+from gateway.goby.portal.errors import AppConfigError
 from util.logsetup import add_verbosity_argument
 
 INTERPROCESS_ENV = "GOBY_INTERPROCESS"
@@ -42,7 +42,7 @@ def _merge_text(target: pb_message.Message, text: str, where: str) -> None:
     try:
         text_format.Merge(text, target)
     except text_format.ParseError as exc:
-        raise ConfigError(f"{where}: {exc}") from None
+        raise AppConfigError(f"{where}: {exc}") from None
 
 
 def _scalar_override(field: pb_descriptor.FieldDescriptor, value: str) -> str:
@@ -81,7 +81,7 @@ def load_config(
     config_type: type[pb_message.Message], argv: list[str] | None = None, prog: str | None = None,
     environ: dict[str, str] | None = None,
 ) -> LoadedConfig:
-    """Parse ``argv`` into a ``config_type`` message; ``ConfigError`` names the file/option that is wrong."""
+    """Parse ``argv`` into a ``config_type`` message; ``AppConfigError`` names the file/option that is wrong."""
     environ = os.environ if environ is None else environ
     parser = build_parser(config_type, prog)
     args = parser.parse_args(argv)
@@ -93,7 +93,7 @@ def load_config(
         try:
             text = Path(path).read_text()
         except OSError as exc:
-            raise ConfigError(f"cannot read configuration file {path}: {exc.strerror}") from None
+            raise AppConfigError(f"cannot read configuration file {path}: {exc.strerror}") from None
         _merge_text(cfg, text, f"configuration file {path}")
     for field in config_type.DESCRIPTOR.fields:
         for value in getattr(args, f"field_{field.name}", None) or ():
@@ -115,7 +115,7 @@ def load_config(
             cfg.app.name = prog or os.path.basename(sys.argv[0] or "app")
     if not cfg.IsInitialized():
         missing = ", ".join(cfg.FindInitializationErrors())
-        raise ConfigError(f"configuration is missing required field(s): {missing}")
+        raise AppConfigError(f"configuration is missing required field(s): {missing}")
     verbosity = args.verbose
     debug_cfg = False
     if "app" in fields:
@@ -229,7 +229,7 @@ def load_for_run(config_type: type[pb_message.Message], argv: list[str] | None, 
     """
     try:
         loaded = load_config(config_type, argv, prog)
-    except ConfigError as exc:
+    except AppConfigError as exc:
         print(f"{prog}: configuration error: {exc}", file=sys.stderr)
         return 2
     if loaded.example_requested:
