@@ -120,7 +120,8 @@ def load_extension(point: ExtensionPoint, spec: str) -> Any:
     try:
         return importlib.import_module(spec)
     except Exception as exc:
-        missing = isinstance(exc, ModuleNotFoundError) and exc.name is not None and spec.startswith(exc.name)
+        name = exc.name if isinstance(exc, ModuleNotFoundError) else None
+        missing = name is not None and (spec == name or spec.startswith(name + "."))  # the spec, not a dependency
         raise point.error(spec, f"{type(exc).__name__}: {exc}{_known(point) if missing else ''}") from exc
 
 
