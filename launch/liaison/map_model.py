@@ -1,0 +1,173 @@
+"""The live map's state: vehicles from NodeStatus (position, heading, trail) and the mission's overlays.
+
+Threads: :meth:`MapModel.ingest_node_status` and :meth:`ingest_command` run on the portal thread and only keep the
+newest payload (under a lock held for microseconds); :meth:`tick` decodes them on the web thread, once per update
+period, so a fast node_status group costs the map one decode per vehicle per tick.  Positions are local x/y metres
+(``local_fix``; the frontseat interface fills it), drawn without map tiles.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any
+
+from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
+from launch.usv.geometry import radial_polygon
+from translators.usv.protobuf.command_dccl_pb2 import USVCommand
+
+log = logging.getLogger(__name__)
+
+NODE_STATUS_TYPE = NodeStatus.DESCRIPTOR.full_name
+USV_COMMAND_TYPE = USVCommand.DESCRIPTOR.full_name
+Point = tuple[float, float]
+
+
+@dataclass(eq=False)
+class _Vehicle:
+    name: str
+    trail: deque[Point]
+    type: str = ""
+    x: float = 0.0
+    y: float = 0.0
+    heading: float = 0.0
+    speed: float = 0.0
+    time: float = 0.0
+    appended: list[Point] = field(default_factory=list)
+
+    def view(self, full: bool) -> dict[str, Any]:
+        out = {"name": self.name, "type": self.type, "x": round(self.x, 2), "y": round(self.y, 2),
+               "heading": round(self.heading, 1), "speed": round(self.speed, 2), "time": self.time}
+        if full:
+            out["trail"] = [list(p) for p in self.trail]
+        else:
+            out["append"] = [list(p) for p in self.appended]
+        return out
+
+
+class MapModel:
+    """Vehicles by name, the waypoint track and the loiter polygon (from the config, moved by USV commands)."""
+
+    def __init__(self, waypoints: list[Point], polygon: list[Point], center_activate: bool = False,
+                 trail_points: int = 600) -> None:
+        self.waypoints = list(waypoints)
+        self.polygon = list(polygon)
+        self.mode: str | None = None
+        self.center_activate = center_activate
+        self.trail_points = max(2, trail_points)
+        self._lock = threading.Lock()
+        self._node_payloads: dict[str, bytes] = {}
+        self._command_payload: bytes | None = None
+        self._vehicles: dict[str, _Vehicle] = {}
+        self._last_command_time: float | None = None
+        self._overlay_changed = True
+        self._centred = not center_activate
+
+    # ---------------------------------------------------------------------------------- portal thread
+    def ingest_node_status(self, group: str, payload: bytes) -> None:
+        """Keep the newest NodeStatus of a group. Runs on the portal thread."""
+        with self._lock:
+            self._node_payloads[group] = payload
+
+    def ingest_command(self, payload: bytes) -> None:
+        """Keep the newest USVCommand seen on any group. Runs on the portal thread."""
+        with self._lock:
+            self._command_payload = payload
+
+    # ------------------------------------------------------------------------------------- web thread
+    def tick(self) -> dict[str, Any] | None:
+        """Decode what arrived since the last tick; the changes as a view, or None. Web thread."""
+        with self._lock:
+            nodes, self._node_payloads = self._node_payloads, {}
+            command, self._command_payload = self._command_payload, None
+        changed = []
+        for group, payload in nodes.items():
+            vehicle = self._update_vehicle(group, payload)
+            if vehicle is not None:
+                changed.append(vehicle)
+        if command is not None:
+            self._apply_command(command)
+        if not self._centred and self._usv() is not None:
+            self._centre_polygon()
+            self._centred = True
+        if not changed and not self._overlay_changed:
+            return None
+        update: dict[str, Any] = {"vehicles": [v.view(full=False) for v in changed]}
+        for vehicle in changed:
+            vehicle.appended.clear()
+        if self._overlay_changed:
+            update.update(self._overlays())
+            self._overlay_changed = False
+        return update
+
+    def snapshot(self) -> dict[str, Any]:
+        """Everything, trails included, for a page that just connected. Web thread."""
+        return {"vehicles": [v.view(full=True) for v in self._vehicles.values()], **self._overlays()}
+
+    def _overlays(self) -> dict[str, Any]:
+        return {"waypoints": [list(p) for p in self.waypoints], "polygon": [list(p) for p in self.polygon],
+                "mode": self.mode}
+
+    def _update_vehicle(self, group: str, payload: bytes) -> _Vehicle | None:
+        status = NodeStatus()
+        try:
+            status.ParseFromString(payload)
+        except Exception as exc:  # noqa: BLE001 - bad input from the broker: report, keep serving
+            log.warning("map: NodeStatus on %s does not parse: %s", group, exc)
+            return None
+        if not status.HasField("local_fix"):
+            return None
+        name = status.name or group
+        vehicle = self._vehicles.get(name)
+        if vehicle is None:
+            vehicle = self._vehicles[name] = _Vehicle(name, deque(maxlen=self.trail_points))
+        vehicle.type = NodeStatus.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_number[status.type].name \
+            if status.HasField("type") else ""
+        vehicle.x, vehicle.y = status.local_fix.x, status.local_fix.y
+        vehicle.heading = status.pose.heading
+        vehicle.speed = status.speed.over_ground
+        vehicle.time = status.time
+        point = (round(vehicle.x, 1), round(vehicle.y, 1))
+        if not vehicle.trail or vehicle.trail[-1] != point:
+            vehicle.trail.append(point)
+            vehicle.appended.append(point)
+        return vehicle
+
+    def _usv(self) -> _Vehicle | None:
+        usvs = [v for v in self._vehicles.values() if v.type == "USV"]
+        if usvs:
+            return usvs[0]
+        return next(iter(self._vehicles.values())) if len(self._vehicles) == 1 else None
+
+    def _centre_polygon(self) -> None:
+        usv = self._usv()
+        if usv is None or not self.polygon:
+            return
+        xs = [p[0] for p in self.polygon]
+        ys = [p[1] for p in self.polygon]
+        dx = usv.x - (min(xs) + max(xs)) / 2
+        dy = usv.y - (min(ys) + max(ys)) / 2
+        self.polygon = [(x + dx, y + dy) for x, y in self.polygon]
+        self._overlay_changed = True
+
+    def _apply_command(self, payload: bytes) -> None:
+        command = USVCommand()
+        try:
+            command.ParseFromString(payload)
+        except Exception as exc:  # noqa: BLE001
+            log.warning("map: USVCommand does not parse: %s", exc)
+            return
+        if command.time == self._last_command_time:
+            return  # the same command seen again on another group (the manager republishes it)
+        self._last_command_time = command.time
+        if command.desired_state == USVCommand.POLYGON and command.polygon_sides >= 3 and command.polygon_radius > 0:
+            ring = radial_polygon(0.0, 0.0, command.polygon_radius, command.polygon_sides)
+            self.polygon = [(round(x, 1), round(y, 1)) for x, y in ring.vertices]
+            if self.center_activate:
+                self._centre_polygon()
+            self.mode = "polygon"
+        elif command.desired_state == USVCommand.WAYPOINTS:
+            self.mode = "waypoints"
+        self._overlay_changed = True

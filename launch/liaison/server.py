@@ -1,0 +1,414 @@
+"""The web side of goby-liaison: aiohttp on its own thread and event loop, pages and one WebSocket per page.
+
+Threads: :class:`WebServer` runs an asyncio loop on the thread ``liaison-web``.  The portal thread never waits
+for it: the portal side writes into the models (``ScopeModel.ingest``, ``MapModel.ingest_*``: a lock held for a
+dict update) and reports command outcomes with :meth:`WebServer.call` (``loop.call_soon_threadsafe``).  The web
+thread hands commands to the portal thread with the ``publish`` callable it was given (the portal thread's
+``call_soon``).  Every ``1/update_freq`` s the ticker reads the models (coalescing whatever arrived) and offers
+one update per view to each page's bounded queue (``fanout.Browser``).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import re
+import threading
+import time
+from collections.abc import Callable
+from importlib import resources
+from pathlib import Path
+from typing import Any
+from urllib.parse import urlsplit
+
+from aiohttp import WSMsgType, web
+
+from launch.liaison.commander_model import CommanderModel, CommandType, SentCommand, Target
+from launch.liaison.errors import CommandRefused, LiaisonError
+from launch.liaison.fanout import VIEWS, Browser
+from launch.liaison.form_values import build_command
+from launch.liaison.map_model import MapModel
+from launch.liaison.scope_model import ScopeModel
+from launch.liaison.settings import LiaisonSettings
+
+log = logging.getLogger(__name__)
+
+STATIC_DIR = Path(str(resources.files("launch.liaison") / "static"))
+MAX_WS_MESSAGE = 256 * 1024  # bytes a page may send in one WebSocket message
+HISTORY_ITEMS_SENT = 100
+SEND_RATE_LIMIT = 20  # commands a page may send per second
+#: Publishes a command on the portal thread: (type, target, message, entry id) -> None; never blocks.
+Publish = Callable[[CommandType, Target, Any, int], None]
+
+
+def _json(obj: Any) -> str:
+    return json.dumps(obj, separators=(",", ":"), allow_nan=False, default=str)
+
+
+class WebServer:
+    """Serves the pages of one liaison; ``start()`` binds (LiaisonError if it cannot), ``stop()`` is idempotent."""
+
+    def __init__(self, settings: LiaisonSettings, scope: ScopeModel, commander: CommanderModel, map_model: MapModel,
+                 publish: Publish, clock_now: Callable[[], float]) -> None:
+        self.settings = settings
+        self.scope = scope
+        self.commander = commander
+        self.map = map_model
+        self._publish = publish
+        self._now = clock_now
+        self.browsers: set[Browser] = set()
+        self.port: int | None = None
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._thread: threading.Thread | None = None
+        self._ready = threading.Event()
+        self._error: BaseException | None = None
+        self._stop: asyncio.Event | None = None
+        self._notify_rules = [(re.compile(g), re.compile(t)) for g, t in settings.notify]
+        self._notified: dict[int, int] = {}  # row id -> count when last notified
+        self.ticks = 0
+
+    # ------------------------------------------------------------------------------------- lifecycle
+    def start(self, timeout_s: float = 10.0) -> None:
+        """Start the web thread and bind; raises LiaisonError naming the address when the bind fails."""
+        self._thread = threading.Thread(target=self._run, name="liaison-web", daemon=True)
+        self._thread.start()
+        if not self._ready.wait(timeout_s):
+            raise LiaisonError(f"the web server did not start within {timeout_s:g} s")
+        if self._error is not None:
+            self._thread.join()
+            where = f"{self.settings.http_address}:{self.settings.http_port}"
+            raise LiaisonError(f"cannot serve http on {where} (http_address, http_port): {self._error}")
+
+    def stop(self) -> None:
+        if self._thread is None:
+            return
+        if self._loop is not None and self._stop is not None:
+            try:
+                self._loop.call_soon_threadsafe(self._stop.set)
+            except RuntimeError:
+                pass  # the loop has already closed
+        self._thread.join(15.0)
+        if self._thread.is_alive():
+            log.error("the web thread did not stop within 15 s")
+        self._thread = None
+
+    def call(self, fn: Callable[..., Any], *args: Any) -> None:
+        """Run ``fn(*args)`` on the web thread; callable from any thread, never blocks, dropped once stopped."""
+        loop = self._loop
+        if loop is None or loop.is_closed():
+            return
+        try:
+            loop.call_soon_threadsafe(fn, *args)
+        except RuntimeError:
+            pass  # stopping
+
+    @property
+    def urls(self) -> dict[str, str]:
+        host = self.settings.http_address
+        shown = "127.0.0.1" if host in ("", "0.0.0.0", "::") else host
+        base = f"http://{shown}:{self.port}"
+        return {"home": f"{base}/", "scope": f"{base}/?_=/scope", "commander": f"{base}/?_=/commander",
+                "map": f"{base}/?_=/map"}
+
+    def _run(self) -> None:
+        loop = asyncio.new_event_loop()
+        self._loop = loop
+        try:
+            loop.run_until_complete(self._serve())
+        except BaseException as exc:  # noqa: BLE001 - reported to start() or logged
+            if not self._ready.is_set():
+                self._error = exc
+                self._ready.set()
+            else:
+                log.exception("the web server failed")
+        finally:
+            loop.run_until_complete(loop.shutdown_asyncgens())
+            loop.close()
+
+    async def _serve(self) -> None:
+        self._stop = asyncio.Event()
+        app = web.Application(client_max_size=MAX_WS_MESSAGE)
+        app.router.add_get("/", self._page)
+        for view in ("scope", "commander", "map"):
+            app.router.add_get(f"/{view}", self._page)
+        app.router.add_get("/ws", self._websocket)
+        app.router.add_get("/api/urls", self._api_urls)
+        app.router.add_get("/favicon.ico", self._favicon)
+        app.router.add_static("/static/", STATIC_DIR, show_index=False)
+        runner = web.AppRunner(app, handle_signals=False, access_log=None)
+        await runner.setup()
+        site = web.TCPSite(runner, self.settings.http_address or None, self.settings.http_port,
+                           shutdown_timeout=1.0, reuse_address=True)
+        try:
+            await site.start()
+        except OSError:
+            await runner.cleanup()
+            raise
+        server = getattr(site, "_server", None)
+        sockets = getattr(server, "sockets", None) or []
+        self.port = sockets[0].getsockname()[1] if sockets else self.settings.http_port
+        self._ready.set()
+        ticker = asyncio.ensure_future(self._ticker())
+        try:
+            await self._stop.wait()
+        finally:
+            ticker.cancel()
+            for browser in list(self.browsers):
+                await browser.ws.close(code=1001, message=b"goby-liaison is stopping")
+            await runner.cleanup()
+
+    # ------------------------------------------------------------------------------------------ pages
+    async def _page(self, request: web.Request) -> web.StreamResponse:
+        return web.FileResponse(STATIC_DIR / "index.html", headers={"Cache-Control": "no-cache"})
+
+    async def _favicon(self, request: web.Request) -> web.StreamResponse:
+        return web.FileResponse(STATIC_DIR / "favicon.svg", headers={"Content-Type": "image/svg+xml"})
+
+    async def _api_urls(self, request: web.Request) -> web.Response:
+        return web.json_response(self.urls)
+
+    def _origin_allowed(self, request: web.Request) -> bool:
+        """A page of another site must not drive this one (WebSockets ignore the same-origin policy)."""
+        origin = request.headers.get("Origin")
+        if origin is None:
+            return True
+        return urlsplit(origin).netloc == request.host
+
+    # -------------------------------------------------------------------------------------- websocket
+    async def _websocket(self, request: web.Request) -> web.StreamResponse:
+        if not self._origin_allowed(request):
+            return web.Response(status=403, text=f"origin {request.headers.get('Origin')} may not use this page")
+        if len(self.browsers) >= self.settings.max_clients:
+            return web.Response(status=503, text=f"too many pages open ({self.settings.max_clients}, "
+                                                 "[goby_moos_py.liaison.protobuf.web] max_clients): close one")
+        ws = web.WebSocketResponse(max_msg_size=MAX_WS_MESSAGE, compress=False, heartbeat=20.0)
+        await ws.prepare(request)
+        browser = Browser(ws, request.remote or "?", self.settings.client_queue)
+        browser.paused = self.settings.start_paused
+        browser.set_filters(self.settings.group_filter, self.settings.type_filter)
+        self.browsers.add(browser)
+        sender = asyncio.ensure_future(browser.send_loop())
+        sent_times: list[float] = []
+        try:
+            browser.offer(_json(self._hello()), "hello")
+            async for message in ws:
+                if message.type == WSMsgType.TEXT:
+                    self._handle(browser, message.data, sent_times)
+                elif message.type == WSMsgType.BINARY:
+                    self._reply(browser, "error", error="binary messages are not understood: send JSON text")
+                elif message.type == WSMsgType.ERROR:
+                    log.info("browser %s: %s", browser.address, ws.exception())
+        finally:
+            self.browsers.discard(browser)
+            sender.cancel()
+        return ws
+
+    def _hello(self) -> dict[str, Any]:
+        s = self.settings
+        return {"op": "hello", "title": s.title, "views": s.views, "update_freq": s.update_freq,
+                "start_paused": s.start_paused, "filters": {"group": s.group_filter, "type": s.type_filter},
+                "max_history": s.max_history, "history_groups": s.history_groups}
+
+    def _reply(self, browser: Browser, op: str, **fields: Any) -> None:
+        browser.offer(_json({"op": op, **fields}), "reply")
+
+    def _handle(self, browser: Browser, text: str, sent_times: list[float]) -> None:
+        """One message from a page: every bad one gets an ``error`` reply naming the cause."""
+        try:
+            request = json.loads(text)
+        except ValueError as exc:
+            self._reply(browser, "error", error=f"message is not JSON: {exc}")
+            return
+        if not isinstance(request, dict) or not isinstance(request.get("op"), str):
+            self._reply(browser, "error", error='message must be a JSON object with an "op" string')
+            return
+        op = request["op"]
+        handler = {
+            "subscribe": self._on_subscribe, "filter": self._on_filter, "pause": self._on_pause,
+            "resume": self._on_resume, "expand": self._on_expand, "collapse": self._on_collapse,
+            "send": lambda b, r: self._on_send(b, r, sent_times),
+        }.get(op)
+        if handler is None:
+            self._reply(browser, "error", error=f"unknown op {op!r}")
+            return
+        try:
+            handler(browser, request)
+        except (KeyError, TypeError, ValueError) as exc:
+            self._reply(browser, "error", op_failed=op, error=f"bad {op} request: {exc}")
+
+    def _on_subscribe(self, browser: Browser, request: dict[str, Any]) -> None:
+        views = request.get("views")
+        if not isinstance(views, list) or not all(isinstance(v, str) for v in views):
+            raise ValueError('"views" must be a list of view names')
+        unknown = set(views) - VIEWS
+        if unknown:
+            raise ValueError(f"unknown view(s) {', '.join(sorted(unknown))} (known: {', '.join(sorted(VIEWS))})")
+        browser.views = set(views)
+        for view in browser.views:
+            self._send_full(browser, view)
+
+    def _on_filter(self, browser: Browser, request: dict[str, Any]) -> None:
+        group, type_ = request.get("group", ".*"), request.get("type", ".*")
+        if not isinstance(group, str) or not isinstance(type_, str):
+            raise ValueError('"group" and "type" must be strings')
+        browser.set_filters(group, type_)  # ValueError names the bad expression
+        self._reply(browser, "filter", group=group, type=type_)
+        self._send_full(browser, "scope")
+
+    def _on_pause(self, browser: Browser, request: dict[str, Any]) -> None:
+        browser.paused = True
+        self._reply(browser, "paused", paused=True)
+
+    def _on_resume(self, browser: Browser, request: dict[str, Any]) -> None:
+        browser.paused = False
+        self._reply(browser, "paused", paused=False)
+        self._send_full(browser, "scope")
+
+    def _on_expand(self, browser: Browser, request: dict[str, Any]) -> None:
+        row_id = int(request["id"])
+        items = self.scope.history(row_id, HISTORY_ITEMS_SENT)
+        if items is None:
+            raise ValueError(f"no scope row {row_id}")
+        browser.expanded.add(row_id)
+        self._reply(browser, "history", id=row_id, items=items)
+
+    def _on_collapse(self, browser: Browser, request: dict[str, Any]) -> None:
+        browser.expanded.discard(int(request["id"]))
+
+    def _on_send(self, browser: Browser, request: dict[str, Any], sent_times: list[float]) -> None:
+        now = time.monotonic()
+        sent_times[:] = [t for t in sent_times if now - t < 1.0]
+        if len(sent_times) >= SEND_RATE_LIMIT:
+            self._reply(browser, "refused", field="", error=f"more than {SEND_RATE_LIMIT} commands a second")
+            return
+        try:
+            kind, target, msg = self._check_command(request)
+        except CommandRefused as exc:
+            self._reply(browser, "refused", field=exc.field, error=str(exc))
+            return
+        sent_times.append(now)
+        comment = request.get("comment", "")
+        entry = self.commander.record(kind, target, msg, browser.address, comment if isinstance(comment, str) else "",
+                                      self._now())
+        self._reply(browser, "accepted", id=entry.id, text=entry.text, target=entry.target)
+        self._publish(kind, target, msg, entry.id)
+        self._broadcast_sent([entry])
+
+    def _check_command(self, request: dict[str, Any]) -> tuple[CommandType, Target, Any]:
+        name = request.get("type")
+        kind = self.commander.types.get(name) if isinstance(name, str) else None
+        if kind is None:
+            raise CommandRefused(f"type {name!r} is not in the configured list "
+                                 f"({', '.join(sorted(self.commander.types)) or 'none'})", "type")
+        index = request.get("target")
+        if not isinstance(index, int) or isinstance(index, bool) or not 0 <= index < len(kind.targets):
+            allowed = "; ".join(f"{t.index}: {t.label}" for t in kind.targets) or "none configured"
+            raise CommandRefused(f"target {index!r} is not a configured publish_to of {name} ({allowed})", "target")
+        msg = build_command(kind.cls, request.get("values", {}), self._now)
+        return kind, kind.targets[index], msg
+
+    # -------------------------------------------------------------------- outcomes (scheduled by portal)
+    def command_published(self, entry_id: int, error: str | None) -> None:
+        """The portal thread published a command (or failed). Web thread."""
+        entry = self.commander.published(entry_id, error)
+        if entry is not None:
+            self._broadcast_sent([entry])
+
+    def command_acknowledged(self, entry_id: int, text: str) -> None:
+        """The layer acknowledged a command (intervehicle). Web thread."""
+        entry = self.commander.acknowledged(entry_id, text)
+        if entry is not None:
+            self._broadcast_sent([entry])
+
+    def command_expired(self, entry_id: int, text: str) -> None:
+        """The layer gave up on a command (intervehicle). Web thread."""
+        entry = self.commander.expired(entry_id, text)
+        if entry is not None:
+            self._broadcast_sent([entry])
+
+    def interprocess_ack(self, type_name: str, value: Any, text: str, final: bool, refused: bool) -> None:
+        """An ack message of a configured ``interprocess_ack`` rule arrived. Web thread."""
+        entry = self.commander.interprocess_ack(type_name, value, text, final, refused)
+        if entry is not None:
+            self._broadcast_sent([entry])
+
+    # ----------------------------------------------------------------------------------------- fan-out
+    def _broadcast_sent(self, entries: list[SentCommand]) -> None:
+        text = _json({"op": "sent", "entries": [e.view() for e in entries], "full": False})
+        for browser in self.browsers:
+            if "commander" in browser.views:
+                browser.offer(text, "commander")
+
+    def _send_full(self, browser: Browser, view: str) -> None:
+        if view == "scope":
+            rows = [r for r in self.scope.views() if browser.shows(r)] if not browser.paused else None
+            if rows is not None:
+                browser.offer(_json({"op": "scope", "rows": rows, "full": True}), "scope")
+        elif view == "commander":
+            browser.offer(_json({"op": "commands", "types": self.commander.catalogue()}), "commander")
+            browser.offer(_json({"op": "sent", "entries": [e.view() for e in self.commander.history],
+                                 "full": True}), "commander")
+        elif view == "map":
+            browser.offer(_json({"op": "map", "full": True, **self.map.snapshot()}), "map")
+        browser.needs_resync.discard(view)
+
+    async def _ticker(self) -> None:
+        period = 1.0 / self.settings.update_freq
+        next_at = time.monotonic()
+        while True:
+            next_at += period
+            await asyncio.sleep(max(0.0, next_at - time.monotonic()))
+            if time.monotonic() - next_at > period:
+                next_at = time.monotonic()  # fell behind: skip, do not burst
+            try:
+                self.tick()
+            except Exception:  # noqa: BLE001 - a bug in one tick must not stop the page
+                log.exception("liaison tick failed")
+
+    def tick(self) -> None:
+        """Read the models and offer each page what changed. Web thread."""
+        self.ticks += 1
+        now = time.monotonic()
+        rows = self.scope.tick(now)
+        map_update = self.map.tick()
+        expired = self.commander.expire_due(now)
+        if expired:
+            self._broadcast_sent(expired)
+        notices = self._notifications(rows)
+        by_filter: dict[tuple[str, str], str] = {}
+        changed_ids = {int(r["id"]) for r in rows}
+        map_text = _json({"op": "map", "full": False, **map_update}) if map_update else None
+        for browser in list(self.browsers):
+            for view in list(browser.needs_resync):
+                if browser.has_room():
+                    self._send_full(browser, view)
+            if "scope" in browser.views and rows and not browser.paused and "scope" not in browser.needs_resync:
+                key = browser.filter_key
+                text = by_filter.get(key)
+                if text is None:
+                    shown = [r for r in rows if browser.shows(r)]
+                    text = by_filter[key] = _json({"op": "scope", "rows": shown, "full": False}) if shown else ""
+                if text:
+                    browser.offer(text, "scope")
+                for row_id in browser.expanded & changed_ids:
+                    items = self.scope.history(row_id, HISTORY_ITEMS_SENT)
+                    if items is not None:
+                        self._reply(browser, "history", id=row_id, items=items)
+            if map_text and "map" in browser.views and "map" not in browser.needs_resync:
+                browser.offer(map_text, "map")
+            if notices and "commander" in browser.views:
+                browser.offer(_json({"op": "notify", "items": notices}), "commander")
+
+    def _notifications(self, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+        if not self._notify_rules:
+            return []
+        notices = []
+        for row in rows:
+            if self._notified.get(row["id"]) == row["count"]:
+                continue  # re-sent for its rate only
+            if any(g.fullmatch(row["group"]) and t.fullmatch(row["type"]) for g, t in self._notify_rules):
+                self._notified[row["id"]] = row["count"]
+                notices.append({"group": row["group"], "type": row["type"], "time": row["time"],
+                                "value": row["value"]})
+        return notices

@@ -1,0 +1,154 @@
+"""goby-liaison's configuration, checked: everything a config names must exist before the page is served.
+
+Reads Goby's ``LiaisonConfig`` and our extension ``[goby_moos_py.liaison.protobuf.web]``; imports the message
+modules it names; refuses (LiaisonConfigError naming the field) a type that cannot be found, a bad regex, a
+target layer this build cannot publish on, ``load_proto_file``/``load_proto_dir`` (no .proto compiler at run
+time here: compile and import instead).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from google.protobuf.message import Message
+
+from gateway.goby.protobuf.layer_pb2 import LAYER_INTERVEHICLE, Layer
+from launch.liaison.commander_model import CommandType, Target
+from launch.liaison.errors import LiaisonConfigError
+from launch.liaison.fanout import compile_filter
+from launch.liaison.message_types import find_message_type, import_project_protos, load_message_modules
+from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
+from launch.liaison.protobuf.liaison_web_pb2 import InterProcessAck, WebConfig, web
+
+Point = tuple[float, float]
+#: The layers a command can be published on in this build (intervehicle comes with the intervehicle layer).
+SUPPORTED_LAYERS = frozenset(v.number for v in Layer.DESCRIPTOR.values) - {LAYER_INTERVEHICLE}
+
+
+@dataclass
+class LiaisonSettings:
+    """What the server and the portal thread need, derived once from the config."""
+
+    title: str
+    http_address: str
+    http_port: int
+    update_freq: float
+    start_paused: bool
+    views: dict[str, bool]
+    group_filter: str
+    type_filter: str
+    max_history: int
+    max_message_size: int
+    history_groups: list[str]
+    command_types: list[CommandType]
+    notify: list[tuple[str, str]]
+    waypoints: list[Point] = field(default_factory=list)
+    polygon: list[Point] = field(default_factory=list)
+    center_activate: bool = False
+    trail_points: int = 600
+    client_queue: int = 16
+    max_clients: int = 64
+    max_rows: int = 5000
+    command_history: int = 200
+
+
+def web_config(cfg: LiaisonConfig) -> WebConfig:
+    return cfg.Extensions[web]
+
+
+def _targets(load: LiaisonConfig, cls: type[Message], where: str) -> tuple[Target, ...]:
+    targets = []
+    for index, entry in enumerate(load.publish_to):
+        if entry.layer not in SUPPORTED_LAYERS:
+            raise LiaisonConfigError(
+                f"{where}.publish_to[{index}]: layer {Layer.Name(entry.layer)} is not available in this build "
+                "(use LAYER_INTERPROCESS)")
+        numeric_field = entry.group_numeric_field_name if entry.HasField("group_numeric_field_name") else ""
+        if numeric_field and numeric_field not in cls.DESCRIPTOR.fields_by_name:
+            raise LiaisonConfigError(f"{where}.publish_to[{index}]: {cls.DESCRIPTOR.full_name} has no field "
+                                     f"{numeric_field!r} (group_numeric_field_name)")
+        if not entry.group.strip():
+            raise LiaisonConfigError(f"{where}.publish_to[{index}]: empty group")
+        targets.append(Target(index, entry.group, entry.group_numeric, numeric_field, entry.layer))
+    return tuple(targets)
+
+
+def _ack_rules(rules: list[InterProcessAck]) -> dict[str, InterProcessAck]:
+    out = {}
+    for index, rule in enumerate(rules):
+        where = f"[goby_moos_py.liaison.protobuf.web].interprocess_ack[{index}]"
+        command = find_message_type(rule.command_type)
+        ack = find_message_type(rule.ack_type)
+        for cls, name, what in ((command, rule.command_field, "command_field"), (ack, rule.ack_field, "ack_field")):
+            if name not in cls.DESCRIPTOR.fields_by_name:
+                raise LiaisonConfigError(f"{where}.{what}: {cls.DESCRIPTOR.full_name} has no field {name!r}")
+        if rule.HasField("final_field") and rule.final_field not in ack.DESCRIPTOR.fields_by_name:
+            raise LiaisonConfigError(f"{where}.final_field: {rule.ack_type} has no field {rule.final_field!r}")
+        out[rule.command_type] = rule
+    return out
+
+
+def load_settings(cfg: LiaisonConfig) -> LiaisonSettings:
+    """Check the config and derive the settings; LiaisonConfigError names the offending field."""
+    for name in ("load_proto_file", "load_proto_dir"):
+        if getattr(cfg, name):
+            raise LiaisonConfigError(f"{name} is not supported here (no .proto compiler at run time): compile the "
+                                     "file with protoc and name the generated module in load_shared_library")
+    extra = web_config(cfg)
+    import_project_protos()
+    load_message_modules([*cfg.load_shared_library, *extra.load_python_module])
+    acks = _ack_rules(list(extra.interprocess_ack))
+    types = []
+    seen = set()
+    for index, load in enumerate(cfg.pb_commander_config.load_protobuf):
+        where = f"pb_commander_config.load_protobuf[{index}]"
+        try:
+            cls = find_message_type(load.name)
+        except LiaisonConfigError as exc:
+            raise LiaisonConfigError(f"{where}.name: {exc}") from None
+        if load.name in seen:
+            raise LiaisonConfigError(f"{where}.name: {load.name} is listed twice")
+        seen.add(load.name)
+        types.append(CommandType(load.name, cls, _targets(load, cls, where), acks.get(load.name)))
+    scope = cfg.pb_scope_config
+    for expression, what in ((scope.group_regex_filter_expression, "group"),
+                             (scope.type_regex_filter_expression, "type")):
+        try:
+            compile_filter(expression, what)
+        except ValueError as exc:
+            raise LiaisonConfigError(f"pb_scope_config: {exc}") from None
+    notify = []
+    for index, sub in enumerate(cfg.pb_commander_config.notify_subscribe):
+        for expression, what in ((sub.group_regex, "group"), (sub.type_regex, "type")):
+            try:
+                compile_filter(expression, what)
+            except ValueError as exc:
+                raise LiaisonConfigError(f"pb_commander_config.notify_subscribe[{index}]: {exc}") from None
+        notify.append((sub.group_regex, sub.type_regex))
+    if not cfg.update_freq > 0:
+        raise LiaisonConfigError(f"update_freq must be > 0 Hz, not {cfg.update_freq:g}")
+    platform = cfg.interprocess.platform
+    return LiaisonSettings(
+        title=f"goby liaison: {platform}",
+        http_address=cfg.http_address,
+        http_port=cfg.http_port,
+        update_freq=cfg.update_freq,
+        start_paused=cfg.start_paused,
+        views={"scope": cfg.add_scope_tab, "commander": cfg.add_commander_tab, "home": cfg.add_home_tab,
+               "map": True},
+        group_filter=scope.group_regex_filter_expression,
+        type_filter=scope.type_regex_filter_expression,
+        max_history=scope.max_history_items,
+        max_message_size=scope.max_message_size_bytes,
+        history_groups=[h.group for h in scope.history],
+        command_types=types,
+        notify=notify,
+        waypoints=[(p.x, p.y) for p in extra.map.waypoint],
+        polygon=[(p.x, p.y) for p in extra.map.loiter_polygon],
+        center_activate=extra.map.center_activate,
+        trail_points=extra.map.trail_points,
+        client_queue=extra.client_queue_updates,
+        max_clients=extra.max_clients,
+        max_rows=extra.max_scope_rows,
+        command_history=extra.command_history,
+    )
