@@ -9,6 +9,7 @@ period, so a fast node_status group costs the map one decode per vehicle per tic
 from __future__ import annotations
 
 import logging
+import math
 import threading
 from collections import deque
 from dataclasses import dataclass, field
@@ -23,6 +24,7 @@ log = logging.getLogger(__name__)
 NODE_STATUS_TYPE = NodeStatus.DESCRIPTOR.full_name
 USV_COMMAND_TYPE = USVCommand.DESCRIPTOR.full_name
 Point = tuple[float, float]
+TRAIL_SPACING_M = 5.0  # a trail point is kept once the vehicle has moved this far from the last one
 
 
 @dataclass(eq=False)
@@ -126,11 +128,12 @@ class MapModel:
         vehicle.type = NodeStatus.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_number[status.type].name \
             if status.HasField("type") else ""
         vehicle.x, vehicle.y = status.local_fix.x, status.local_fix.y
-        vehicle.heading = status.pose.heading
+        vehicle.heading = status.pose.heading % 360.0
         vehicle.speed = status.speed.over_ground
         vehicle.time = status.time
         point = (round(vehicle.x, 1), round(vehicle.y, 1))
-        if not vehicle.trail or vehicle.trail[-1] != point:
+        last = vehicle.trail[-1] if vehicle.trail else None
+        if last is None or math.hypot(point[0] - last[0], point[1] - last[1]) >= TRAIL_SPACING_M:
             vehicle.trail.append(point)
             vehicle.appended.append(point)
         return vehicle

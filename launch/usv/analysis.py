@@ -197,6 +197,16 @@ def bhv_waypoints(bhv_file: Path) -> list[Point]:
     return parse_points(match.group(1).strip()) if match else []
 
 
+def bhv_loiter_polygon(bhv_file: Path) -> Polygon | None:
+    """The ``polygon =`` of the first BHV_Loiter block in a .bhv file, if it is one this module can read."""
+    text = re.sub(r"//[^\n]*", "", bhv_file.read_text())
+    block = re.search(r"BHV_Loiter\s*\{(.*?)\}", text, flags=re.S)
+    if not block:
+        return None
+    match = re.search(r"^\s*polygon\s*=\s*(.+)$", block.group(1), flags=re.M)
+    return parse_polygon(match.group(1).strip()) if match else None
+
+
 def _bearing(a: Point, b: Point) -> float:
     return math.degrees(math.atan2(b[0] - a[0], b[1] - a[1])) % 360.0
 

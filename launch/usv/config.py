@@ -14,8 +14,9 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-from launch.config import fail, render
+from launch.config import fail, render, text_format_string
 from launch.errors import MissionConfigError
+from launch.usv.analysis import bhv_loiter_polygon, bhv_waypoints
 from launch.usv.settings import USV_DIR, UsvSettings
 
 TEMPLATES = USV_DIR / "templates"
@@ -36,6 +37,8 @@ def _values(settings: UsvSettings, app: str) -> dict[str, object]:
         "vehicle_id": settings.vehicle_id,
         "bhv_file": settings.bhv_file,
         "timeout": settings.liveness_timeout,
+        "liaison_address": text_format_string(settings.liaison_address),
+        "liaison_port": settings.liaison_port,
     }
     values["app_block"] = render(TEMPLATES / "_app.pb.cfg.in", values)
     values["interprocess_block"] = render(TEMPLATES / "_interprocess.pb.cfg.in", values)
@@ -47,6 +50,17 @@ def _pb(template: str, app: str) -> Callable[[UsvSettings], str]:
         return render(TEMPLATES / template, _values(settings, app))
 
     return generate
+
+
+def _liaison(settings: UsvSettings) -> str:
+    """goby-liaison's config: the course's liaison.pb.cfg.in, our commander target and the map of usv.bhv."""
+    values = _values(settings, "goby-liaison")
+    points = "\n    ".join(f"waypoint {{ x: {x:g} y: {y:g} }}" for x, y in bhv_waypoints(settings.bhv_file))
+    polygon = bhv_loiter_polygon(settings.bhv_file)
+    if polygon is not None:
+        points += "\n    " + "\n    ".join(f"loiter_polygon {{ x: {x:.1f} y: {y:.1f} }}" for x, y in polygon.vertices)
+    values["map_points"] = points
+    return render(TEMPLATES / "liaison.pb.cfg.in", values)
 
 
 def moos_file_text(settings: UsvSettings) -> str:
@@ -79,6 +93,7 @@ GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
     "usv_manager": _pb("usv_manager.pb.cfg.in", "usv-manager"),
     "shore": _pb("shore.pb.cfg.in", "usv-shore"),
     "usv_command": _pb("shore.pb.cfg.in", "usv-command"),  # for sending commands by hand
+    "liaison": _liaison,
     "moos": _moos,
 }
 

@@ -88,6 +88,12 @@ def build_parser() -> argparse.ArgumentParser:
                         help="lat,lon of the local grid (default %(default)s)")
     parser.add_argument("--moos-port", type=int, default=0, help="MOOSDB port (default 9001 if free)")
     parser.add_argument("--sim-port", type=int, default=0, help="frontseat simulator port (default 55001 if free)")
+    parser.add_argument("--liaison-port", type=int, default=0,
+                        help="goby-liaison's web page port (default 50001, the course's, if free)")
+    parser.add_argument("--listen", default="127.0.0.1", metavar="ADDRESS",
+                        help="address goby-liaison's page listens on (default 127.0.0.1, this machine only). "
+                        "RISK: another address (0.0.0.0 = every interface) lets anyone who can reach it watch "
+                        "all traffic and command the vehicle: the page has no login")
     add_verbosity_argument(parser)
     return parser
 
@@ -112,6 +118,8 @@ def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> 
         lon_origin=lon,
         moos_port=_port(args.moos_port, 9001),
         sim_port=_port(args.sim_port, 55001),
+        liaison_address=args.listen,
+        liaison_port=_port(args.liaison_port, 50001),
         moosdb=choose_program(args.moosdb, "MOOSDB", "moos-db"),
         helm=choose_program(args.helm, "pHelmIvP", "ivp-helm"),
         schedule=args.schedule,
@@ -180,8 +188,8 @@ def run_demo(args: argparse.Namespace) -> int:
     planned = len(parse_schedule(settings.schedule))
     print(f"USV mission: {settings.moosdb}, {settings.helm}, warp {settings.warp}, MOOS port {settings.moos_port}, "
           f"simulator port {settings.sim_port}; logs in {settings.log_dir}", flush=True)
-    print(f"shore schedule: {settings.schedule}" + ("" if planned else " (no commands: send them with usv-command)"),
-          flush=True)
+    print(f"shore schedule: {settings.schedule}" + ("" if planned else " (no commands: send them from the "
+                                                      "commander page or with usv-command)"), flush=True)
     mission = UsvMission(settings)
     previous = {s: signal.signal(s, lambda *_: mission.stop_event.set()) for s in (signal.SIGINT, signal.SIGTERM)}
     failure = None
@@ -189,8 +197,12 @@ def run_demo(args: argparse.Namespace) -> int:
     try:
         mission.start()
         print("waiting for the frontseat interface to reach COMMAND ...", flush=True)
+        urls = mission.liaison_urls()
+        print("web pages of this run (goby-liaison): " + ", ".join(f"{view} {url}" for view, url in urls.items()),
+              flush=True)
         if mission.wait_for_command() is not None:
-            print("the vehicle is under helm command. To send commands to THIS run, in another terminal (bash):\n"
+            print(f"the vehicle is under helm command. Command it from the browser: {urls['commander']}\n"
+                  "or, in another terminal (bash):\n"
                   + "\n".join(f"  {line}" for line in command_lines(settings)), flush=True)
         mission.run(duration, lambda t: print(progress_line(mission.record, t, duration), flush=True))
     except LaunchError as exc:

@@ -18,6 +18,7 @@ from pathlib import Path
 from launch.errors import LaunchError, MissionConfigError, ProcessDiedError
 from launch.launcher import child_environment
 from launch.launchfile import parse_file
+from launch.liaison.portal_side import READY_PREFIX as LIAISON_READY
 from launch.process_group import ManagedProcess, ProcessGroup
 from launch.usv.record import MissionRecord, shifted
 from launch.usv.recorder import MoosRecorder, PortalRecorder, SimClock
@@ -129,6 +130,29 @@ class UsvMission:
         self.group.start()
         self.portal = PortalRecorder(self.record, self.clock, self.settings)
         self.portal.start()
+
+    def liaison_urls(self, timeout_s: float = 30.0) -> dict[str, str]:
+        """The URLs goby-liaison serves (home, scope, commander, map), read from its ready line in its log."""
+        assert self.group is not None
+        process = next((p for p in self.group.processes if p.name.endswith("goby-liaison")), None)
+        if process is None:
+            raise LaunchError("the launch file starts no goby-liaison")
+        deadline = time.monotonic() + timeout_s
+        while True:
+            self._check()
+            try:
+                text = process.log_path.read_text(errors="replace")
+            except OSError:
+                text = ""
+            match = re.search(rf"{re.escape(LIAISON_READY)} (\S+)", text)
+            if match:
+                base = match.group(1).rstrip("/")
+                return {"home": f"{base}/", "scope": f"{base}/?_=/scope", "commander": f"{base}/?_=/commander",
+                        "map": f"{base}/?_=/map"}
+            if time.monotonic() > deadline or self.stop_event.is_set():
+                raise LaunchError(f"goby-liaison did not report its address within {timeout_s:g} s "
+                                  f"(log {process.log_path})")
+            time.sleep(0.1)
 
     def _check(self) -> None:
         assert self.group is not None

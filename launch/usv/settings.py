@@ -39,6 +39,8 @@ _ENV = {
     "bhv_file": "USV_BHV_FILE",
     "schedule": "USV_SHORE_SCHEDULE",
     "socket_name": "USV_SOCKET_NAME",
+    "liaison_address": "USV_LIAISON_ADDRESS",
+    "liaison_port": "USV_LIAISON_PORT",
 }
 
 
@@ -60,11 +62,13 @@ class UsvSettings:
     bhv_file: Path = REPO_ROOT / "behaviors" / "usv.bhv"
     schedule: str = DEFAULT_SCHEDULE
     socket_name: str = ""
+    liaison_address: str = "127.0.0.1"  # goby-liaison's http_address: loopback unless asked (it has no login)
+    liaison_port: int = 50001  # the course's liaison port: 50000 + vehicle id
 
     def __post_init__(self) -> None:
         if self.warp < 1:
             raise MissionConfigError(f"warp must be a whole number >= 1, not {self.warp}")
-        for port_name in ("moos_port", "sim_port"):
+        for port_name in ("moos_port", "sim_port", "liaison_port"):
             port = getattr(self, port_name)
             if not 0 < port < 65536:
                 raise MissionConfigError(f"{port_name} {port} is not a TCP port")
