@@ -136,10 +136,10 @@ class WebServer:
         app.router.add_get("/api/urls", self._api_urls)
         app.router.add_get("/favicon.ico", self._favicon)
         app.router.add_static("/static/", STATIC_DIR, show_index=False)
-        runner = web.AppRunner(app, handle_signals=False, access_log=None)
+        runner = web.AppRunner(app, handle_signals=False, access_log=None, shutdown_timeout=1.0)
         await runner.setup()
         site = web.TCPSite(runner, self.settings.http_address or None, self.settings.http_port,
-                           shutdown_timeout=1.0, reuse_address=True)
+                           reuse_address=True)
         try:
             await site.start()
         except OSError:
