@@ -15,6 +15,7 @@ from typing import Any
 
 CHROMIUM_CANDIDATES = ("chromium", "chromium-browser", "google-chrome")
 CHROMEDRIVER = "chromedriver"
+PROFILE_PREFIX = "liaison-chromium-"  # the browser's profile directory (so its processes can be found)
 CHROMIUM_FLAGS = (
     "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
     "--disable-background-networking", "--disable-component-update", "--disable-sync",
@@ -49,7 +50,7 @@ def chromium(window: tuple[int, int] = (1400, 900)) -> Iterator[Any]:
     browser, driver_path = chromium_paths()
     if browser is None or driver_path is None:
         raise RuntimeError(browser_skip_reason() or "no chromium")
-    profile = Path(tempfile.mkdtemp(prefix="liaison-chromium-"))
+    profile = Path(tempfile.mkdtemp(prefix=PROFILE_PREFIX))
     options = webdriver.ChromeOptions()
     options.binary_location = browser
     for flag in CHROMIUM_FLAGS:

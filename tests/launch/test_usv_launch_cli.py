@@ -67,7 +67,8 @@ def _alive(pid: int) -> bool:
 def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_path):
     socket_dir = Path(tempfile.mkdtemp(prefix="usvl-", dir="/tmp"))
     settings = UsvSettings(run_dir=tmp_path / "run", warp=10, moos_port=free_tcp_port(), sim_port=free_tcp_port(),
-                           moosdb="moos-db", helm="ivp-helm", socket_name=str(socket_dir / "goby_usv"))
+                           liaison_port=free_tcp_port(), moosdb="moos-db", helm="ivp-helm",
+                           socket_name=str(socket_dir / "goby_usv"))
     env = child_environment() | settings.to_env()
     proc = subprocess.Popen(
         [sys.executable, "-m", "launch.launcher", "-d", "200", "--status-period", "1", "-L", str(tmp_path / "logs"),
@@ -76,7 +77,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
     )
     out = OutputReader(proc)
     try:
-        out.wait_for(r"All processes running \(8\)")
+        out.wait_for(r"All processes running \(9\)")
         helm_pid = int(out.wait_for(r"^Launched \((\d+)\) usv\.helm:").group(1))
         os.kill(helm_pid, signal.SIGKILL)
         text = out.finish()
@@ -88,7 +89,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
     assert proc.returncode == 1, text
     assert "usv.helm died unexpectedly (exit status -9)" in text
     pids = [int(p) for p in re.findall(r"^Launched \((\d+)\)", text, flags=re.M)]
-    assert len(pids) == 8
+    assert len(pids) == 9
     assert not any(_alive(pid) for pid in pids), text
     logs = sorted(p.name for p in (tmp_path / "logs").iterdir())
     assert "usv.frontseat-interface.log" in logs and "usv.shore.log" in logs
@@ -100,7 +101,7 @@ def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(
     proc = subprocess.Popen(
         [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--forever", "--warp", "20",
          "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_tcp_port()),
-         "--sim-port", str(free_tcp_port())],
+         "--sim-port", str(free_tcp_port()), "--liaison-port", str(free_tcp_port())],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )
     out = OutputReader(proc)
@@ -114,7 +115,7 @@ def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(
         out.finish()
     assert proc.returncode == 0, text
     assert "=== USV mission summary" in text
-    assert "processes: 8/8 exited cleanly" in text
+    assert "processes: 9/9 exited cleanly" in text
     assert "1. t=" in text and "POLYGON_UPDATES=polygon=radial::x=0,y=0,radius=200,pts=6" in text
     rows = list(csv.DictReader(open(out_dir / "track.csv")))
     assert len(rows) > 50
@@ -127,7 +128,7 @@ def test_demo_names_a_component_that_dies_and_exits_non_zero(tmp_path):
     proc = subprocess.Popen(
         [sys.executable, "-m", "launch.usv.demo", "--out", str(tmp_path / "o"), "--duration", "0", "--warp", "20",
          "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_tcp_port()),
-         "--sim-port", str(free_tcp_port())],
+         "--sim-port", str(free_tcp_port()), "--liaison-port", str(free_tcp_port())],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )
     out = OutputReader(proc)
@@ -177,7 +178,7 @@ def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(t
     proc = subprocess.Popen(
         [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--forever", "--warp", "20",
          "--schedule", "none", "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_tcp_port()),
-         "--sim-port", str(free_tcp_port())],
+         "--sim-port", str(free_tcp_port()), "--liaison-port", str(free_tcp_port())],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )
     out = OutputReader(proc)
@@ -207,7 +208,7 @@ def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(t
     assert re.search(r"^  1\. t=\d+ s: DEPLOY_STATE=WAYPOINTS$", text, flags=re.M), text
     assert "  2. t=" not in text and "acknowledgements: 1 posted to MOOS, 0 refused" in text, text
     assert re.search(r"^waypoints phase t=\d+\.\.\d+ s \(\d+ s, until the end of the run\)", text, flags=re.M), text
-    assert "processes: 8/8 exited cleanly" in text
+    assert "processes: 9/9 exited cleanly" in text
     shore_log = (out_dir / "run" / "logs" / "usv.shore.log").read_text()
     assert "no commands planned" in shore_log and "sent " not in shore_log, shore_log
     headings = [float(h) for h in re.findall(r"hdg=\s*([-\d.]+)", text)]

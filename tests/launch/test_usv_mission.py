@@ -45,6 +45,7 @@ def run_mission(run_dir: Path, moosdb: str, helm: str) -> MissionResult:
         warp=WARP,
         moos_port=free_tcp_port(),
         sim_port=free_tcp_port(),
+        liaison_port=free_tcp_port(),
         moosdb=moosdb,
         helm=helm,
         schedule=SCHEDULE,

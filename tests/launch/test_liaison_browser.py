@@ -1,0 +1,167 @@
+"""goby-liaison in a real headless browser on the running USV mission: the lecture's scope and commander.
+
+One mission (no shore schedule: the browser is the operator) and one browser serve every test in this module.
+Set LIAISON_SCREENSHOT_DIR to keep the screenshots of the three views (docs/ holds the committed ones).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+import pytest
+
+from launch.config import free_tcp_port
+from launch.liaison.testing import browser_skip_reason, chromium
+from launch.usv.analysis import command_effects
+from launch.usv.mission import UsvMission
+from launch.usv.settings import UsvSettings
+
+SKIP = browser_skip_reason()
+pytestmark = pytest.mark.skipif(SKIP is not None, reason=str(SKIP))
+
+FRONTSEAT_GROUPS = ["data_from_frontseat", "desired_course", "helm_state", "node_status", "raw_in", "raw_out",
+                    "status"]
+PREFIX = "goby::middleware::frontseat::"
+
+
+@pytest.fixture(scope="module")
+def mission(tmp_path_factory):
+    run_dir = tmp_path_factory.mktemp("liaison_usv")
+    socket_dir = Path(tempfile.mkdtemp(prefix="usvl-", dir="/tmp"))
+    settings = UsvSettings(run_dir=run_dir, warp=20, moos_port=free_tcp_port(), sim_port=free_tcp_port(),
+                           liaison_port=free_tcp_port(), schedule="none", socket_name=str(socket_dir / "goby_usv"))
+    lines: list[str] = []
+    usv = UsvMission(settings, report=lines.append)
+    try:
+        usv.start()
+        usv.urls = usv.liaison_urls()
+        usv.wait_for_command()
+        yield usv
+    finally:
+        result = usv.stop()
+        shutil.rmtree(socket_dir, ignore_errors=True)
+        assert result.log_errors == [], result.log_errors
+        assert all(o.clean for o in result.outcomes), [o for o in result.outcomes if not o.clean]
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with chromium() as driver:
+        yield driver
+
+
+def screenshot(driver, name: str) -> None:
+    target = os.environ.get("LIAISON_SCREENSHOT_DIR")
+    if target:
+        Path(target).mkdir(parents=True, exist_ok=True)
+        driver.save_screenshot(str(Path(target) / f"liaison_{name}.png"))
+
+
+def wait_for(predicate, timeout_s: float = 20.0, what: str = "condition"):
+    deadline = time.monotonic() + timeout_s
+    while True:
+        value = predicate()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what}")
+        time.sleep(0.1)
+
+
+def scope_counts(driver) -> dict[str, int]:
+    """Visible scope rows: group -> count."""
+    rows = driver.execute_script(
+        "return [...document.querySelectorAll('#scope-table tbody tr.row')].map("
+        "r => [r.children[0].textContent, r.children[5].textContent])")
+    return {group: int(count) for group, count in rows}
+
+
+def test_scope_shows_the_frontseat_groups_updating(mission, browser):
+    browser.get(mission.urls["scope"])
+    wanted = {PREFIX + g for g in FRONTSEAT_GROUPS}
+    first = wait_for(lambda: (c := scope_counts(browser)) and wanted <= set(c) and c, what="the frontseat groups")
+    later = wait_for(lambda: (c := scope_counts(browser)) and all(
+        c[g] > first[g] for g in wanted - {PREFIX + "desired_course"}) and c, what="the counts to grow")
+    assert later[PREFIX + "node_status"] > first[PREFIX + "node_status"]
+    value = browser.execute_script(
+        f"return [...document.querySelectorAll('#scope-table tr.row')].find(r => r.children[0].textContent == "
+        f"'{PREFIX}node_status').children[3].textContent")
+    assert "global_fix" in value and "local_fix" in value  # decoded, in text format
+    screenshot(browser, "scope")
+
+
+def test_a_filter_hides_the_others_and_pause_freezes_the_table(mission, browser):
+    browser.get(mission.urls["scope"])
+    wait_for(lambda: len(scope_counts(browser)) > 7, what="rows")
+    group = browser.find_element("id", "group-filter")
+    group.clear()
+    group.send_keys(".*::node_status")
+    browser.find_element("id", "filter-set").click()
+    shown = wait_for(lambda: (c := scope_counts(browser)) and set(c) == {PREFIX + "node_status"} and c,
+                     what="only node_status to be shown")
+    assert list(shown) == [PREFIX + "node_status"]
+    browser.find_element("id", "filter-clear").click()
+    wait_for(lambda: len(scope_counts(browser)) > 7, what="every row back")
+
+    browser.find_element("id", "pause").click()
+    time.sleep(0.5)  # updates already on their way
+    frozen = scope_counts(browser)
+    time.sleep(2.0)  # node_status arrives at 20 Hz here
+    assert scope_counts(browser) == frozen
+    assert browser.find_element("id", "pause").text == "Play"
+    browser.find_element("id", "pause").click()
+    wait_for(lambda: scope_counts(browser)[PREFIX + "node_status"] > frozen[PREFIX + "node_status"],
+             what="updates after Play")
+
+
+def test_commander_refuses_out_of_range_then_sends_the_octagon(mission, browser):
+    from selenium.webdriver.support.ui import Select
+
+    browser.get(mission.urls["commander"])
+    wait_for(lambda: browser.find_elements("css selector", '[data-path="desired_state"]'), what="the form")
+    Select(browser.find_element("css selector", '[data-path="desired_state"]')).select_by_value("POLYGON")
+    browser.find_element("css selector", '[data-path="polygon_sides"]').send_keys("8")
+    radius = browser.find_element("css selector", '[data-path="polygon_radius"]')
+    radius.send_keys("5000")
+    browser.find_element("id", "send").click()
+    error = browser.find_element("id", "command-error").text
+    assert "polygon_radius" in error and "outside its DCCL bounds [100, 2000]" in error, error
+    assert "invalid" in radius.get_attribute("class")
+    assert browser.find_elements("css selector", "#sent-table tbody tr") == []  # nothing was sent
+
+    before = len(command_effects(mission.record))
+    radius.clear()
+    radius.send_keys("400")
+    browser.find_element("id", "send").click()
+    state = wait_for(lambda: (cell := browser.find_elements("css selector", "#sent-table tbody tr td.state"))
+                     and cell[0].text == "acknowledged" and cell[0], what="the ack in the page")
+    acks = state.find_element("xpath", "following-sibling::td").text
+    assert "POSTED_TO_MOOS" in acks and "DEPLOY_STATE=POLYGON" in acks
+
+    def new_effect():
+        mission.poll()
+        effects = command_effects(mission.record)
+        return effects[before:] if len(effects) > before else None
+
+    (effect,) = wait_for(new_effect, what="the command's postings on the MOOSDB")
+    assert [p.name for p in effect.posts] == ["POLYGON_UPDATES", "DEPLOY_STATE"]  # in that order
+    assert effect.posts[0].value == "polygon=radial::x=0,y=0,radius=400,pts=8"
+    assert effect.posts[1].value == "POLYGON"
+    screenshot(browser, "commander")
+
+
+def test_map_draws_the_vehicle_its_trail_and_the_overlays(mission, browser):
+    browser.get(mission.urls["map"])
+    icon = wait_for(lambda: browser.find_elements("css selector", "#map-vehicles path.vehicle"), what="a vehicle")
+    assert icon[0].get_attribute("data-name") == "usv"
+    assert "rotate(" in icon[0].get_attribute("transform")
+    wait_for(lambda: len(browser.find_element("css selector", "#map-trails polyline").get_attribute("points").split())
+             > 3, what="a trail")
+    assert len(browser.find_element("id", "map-waypoints").get_attribute("points").split()) > 50
+    assert len(browser.find_element("id", "map-polygon").get_attribute("points").split()) in (6, 8)
+    time.sleep(2)  # let the trail grow for the picture
+    screenshot(browser, "map")
