@@ -12,6 +12,7 @@ import sys
 import tempfile
 import threading
 import time
+import urllib.request
 from pathlib import Path
 
 import pytest
@@ -184,7 +185,9 @@ def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(t
     out = OutputReader(proc)
     sent: subprocess.CompletedProcess[str] | None = None
     try:
-        block = out.wait_for(r"To send commands to THIS run, in another terminal \(bash\):\n"
+        commander = out.wait_for(r"Command it from the browser: (http://127\.0\.0\.1:\d+/\?_=/commander)\n")
+        assert urllib.request.urlopen(commander.group(1), timeout=10).status == 200  # the page is served
+        block = out.wait_for(r"or, in another terminal \(bash\):\n"
                              r"  (export .*)\n  (.* waypoints .*)\n  (.* polygon .*)\n")
         export, waypoints = block.group(1), block.group(2)
         out.wait_for(r"^t=\s*\d+ s sim \| interface INTERFACE_COMMAND \| helm DRIVE")
@@ -203,7 +206,7 @@ def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(t
     assert sent.returncode == 0, sent.stdout + sent.stderr
     assert "posted DEPLOY_STATE=WAYPOINTS" in sent.stdout, sent.stdout + sent.stderr
     assert proc.returncode == 0, text
-    assert "shore schedule: none (no commands: send them with usv-command)" in text
+    assert "shore schedule: none (no commands: send them from the commander page or with usv-command)" in text
     # The only command MOOS saw is the user's, and its acknowledgement was recorded by the demo.
     assert re.search(r"^  1\. t=\d+ s: DEPLOY_STATE=WAYPOINTS$", text, flags=re.M), text
     assert "  2. t=" not in text and "acknowledgements: 1 posted to MOOS, 0 refused" in text, text
