@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from frontseat.testing import wait_until
 from launch.config import free_tcp_port
 from launch.liaison.testing import browser_skip_reason, chromium
 from launch.usv.analysis import command_effects
@@ -61,17 +62,6 @@ def screenshot(driver, name: str) -> None:
         driver.save_screenshot(str(Path(target) / f"liaison_{name}.png"))
 
 
-def wait_for(predicate, timeout_s: float = 20.0, what: str = "condition"):
-    deadline = time.monotonic() + timeout_s
-    while True:
-        value = predicate()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.1)
-
-
 def scope_counts(driver) -> dict[str, int]:
     """Visible scope rows: group -> count."""
     rows = driver.execute_script(
@@ -83,8 +73,8 @@ def scope_counts(driver) -> dict[str, int]:
 def test_scope_shows_the_frontseat_groups_updating(mission, browser):
     browser.get(mission.urls["scope"])
     wanted = {PREFIX + g for g in FRONTSEAT_GROUPS}
-    first = wait_for(lambda: (c := scope_counts(browser)) and wanted <= set(c) and c, what="the frontseat groups")
-    later = wait_for(lambda: (c := scope_counts(browser)) and all(
+    first = wait_until(lambda: (c := scope_counts(browser)) and wanted <= set(c) and c, what="the frontseat groups")
+    later = wait_until(lambda: (c := scope_counts(browser)) and all(
         c[g] > first[g] for g in wanted - {PREFIX + "desired_course"}) and c, what="the counts to grow")
     assert later[PREFIX + "node_status"] > first[PREFIX + "node_status"]
     value = browser.execute_script(
@@ -96,16 +86,16 @@ def test_scope_shows_the_frontseat_groups_updating(mission, browser):
 
 def test_a_filter_hides_the_others_and_pause_freezes_the_table(mission, browser):
     browser.get(mission.urls["scope"])
-    wait_for(lambda: len(scope_counts(browser)) > 7, what="rows")
+    wait_until(lambda: len(scope_counts(browser)) > 7, what="rows")
     group = browser.find_element("id", "group-filter")
     group.clear()
     group.send_keys(".*::node_status")
     browser.find_element("id", "filter-set").click()
-    shown = wait_for(lambda: (c := scope_counts(browser)) and set(c) == {PREFIX + "node_status"} and c,
+    shown = wait_until(lambda: (c := scope_counts(browser)) and set(c) == {PREFIX + "node_status"} and c,
                      what="only node_status to be shown")
     assert list(shown) == [PREFIX + "node_status"]
     browser.find_element("id", "filter-clear").click()
-    wait_for(lambda: len(scope_counts(browser)) > 7, what="every row back")
+    wait_until(lambda: len(scope_counts(browser)) > 7, what="every row back")
 
     browser.find_element("id", "pause").click()
     time.sleep(0.5)  # updates already on their way
@@ -114,7 +104,7 @@ def test_a_filter_hides_the_others_and_pause_freezes_the_table(mission, browser)
     assert scope_counts(browser) == frozen
     assert browser.find_element("id", "pause").text == "Play"
     browser.find_element("id", "pause").click()
-    wait_for(lambda: scope_counts(browser)[PREFIX + "node_status"] > frozen[PREFIX + "node_status"],
+    wait_until(lambda: scope_counts(browser)[PREFIX + "node_status"] > frozen[PREFIX + "node_status"],
              what="updates after Play")
 
 
@@ -122,7 +112,7 @@ def test_commander_refuses_out_of_range_then_sends_the_octagon(mission, browser)
     from selenium.webdriver.support.ui import Select
 
     browser.get(mission.urls["commander"])
-    wait_for(lambda: browser.find_elements("css selector", '[data-path="desired_state"]'), what="the form")
+    wait_until(lambda: browser.find_elements("css selector", '[data-path="desired_state"]'), what="the form")
     Select(browser.find_element("css selector", '[data-path="desired_state"]')).select_by_value("POLYGON")
     browser.find_element("css selector", '[data-path="polygon_sides"]').send_keys("8")
     radius = browser.find_element("css selector", '[data-path="polygon_radius"]')
@@ -137,7 +127,7 @@ def test_commander_refuses_out_of_range_then_sends_the_octagon(mission, browser)
     radius.clear()
     radius.send_keys("400")
     browser.find_element("id", "send").click()
-    state = wait_for(lambda: (cell := browser.find_elements("css selector", "#sent-table tbody tr td.state"))
+    state = wait_until(lambda: (cell := browser.find_elements("css selector", "#sent-table tbody tr td.state"))
                      and cell[0].text == "acknowledged" and cell[0], what="the ack in the page")
     acks = state.find_element("xpath", "following-sibling::td").text
     assert "POSTED_TO_MOOS" in acks and "DEPLOY_STATE=POLYGON" in acks
@@ -147,7 +137,7 @@ def test_commander_refuses_out_of_range_then_sends_the_octagon(mission, browser)
         effects = command_effects(mission.record)
         return effects[before:] if len(effects) > before else None
 
-    (effect,) = wait_for(new_effect, what="the command's postings on the MOOSDB")
+    (effect,) = wait_until(new_effect, what="the command's postings on the MOOSDB")
     assert [p.name for p in effect.posts] == ["POLYGON_UPDATES", "DEPLOY_STATE"]  # in that order
     assert effect.posts[0].value == "polygon=radial::x=0,y=0,radius=400,pts=8"
     assert effect.posts[1].value == "POLYGON"
@@ -156,10 +146,10 @@ def test_commander_refuses_out_of_range_then_sends_the_octagon(mission, browser)
 
 def test_map_draws_the_vehicle_its_trail_and_the_overlays(mission, browser):
     browser.get(mission.urls["map"])
-    icon = wait_for(lambda: browser.find_elements("css selector", "#map-vehicles path.vehicle"), what="a vehicle")
+    icon = wait_until(lambda: browser.find_elements("css selector", "#map-vehicles path.vehicle"), what="a vehicle")
     assert icon[0].get_attribute("data-name") == "usv"
     assert "rotate(" in icon[0].get_attribute("transform")
-    wait_for(lambda: len(browser.find_element("css selector", "#map-trails polyline").get_attribute("points").split())
+    wait_until(lambda: len(browser.find_element("css selector", "#map-trails polyline").get_attribute("points").split())
              > 3, what="a trail")
     assert len(browser.find_element("id", "map-waypoints").get_attribute("points").split()) > 50
     assert len(browser.find_element("id", "map-polygon").get_attribute("points").split()) in (6, 8)
