@@ -64,12 +64,23 @@ def is_auto_time(field: FieldDescriptor) -> bool:
     return field.type != FieldDescriptor.TYPE_MESSAGE and dccl_field_options(field).codec in TIME_CODECS
 
 
+def dccl_bounds(field: FieldDescriptor) -> tuple[float, float, float] | None:
+    """(min, max, step) that DCCL gives a numeric field, or None: the one place the liaison reads DCCL bounds."""
+    bounds = field_bounds(field)
+    return None if bounds is None else (bounds.minimum, bounds.maximum, bounds.resolution)
+
+
+def describe_bounds(low: float, high: float, step: float) -> str:
+    """``[100, 2000], in steps of 10`` (the wording of the DCCL check's errors)."""
+    return f"[{low:g}, {high:g}]" + (f", in steps of {step:g}" if step != 1 else "")
+
+
 def numeric_limits(field: FieldDescriptor) -> tuple[float, float, float | None, bool]:
     """(min, max, step, from_dccl) for a numeric field: the DCCL bounds when it has them, else the type's range."""
     kind = field_kind(field)
-    bounds = field_bounds(field)
+    bounds = dccl_bounds(field)
     if bounds is not None:
-        return bounds.minimum, bounds.maximum, bounds.resolution, True
+        return *bounds, True
     if kind in TYPE_RANGES:
         low, high = TYPE_RANGES[kind]
         return low, high, 1, False

@@ -20,12 +20,14 @@ from launch.liaison.errors import CommandRefused
 from launch.liaison.form_schema import (
     FLOAT_MAX,
     TYPE_RANGES,
+    dccl_bounds,
     dccl_field_options,
+    describe_bounds,
     field_kind,
     is_auto_time,
     numeric_limits,
 )
-from translators.usv.validation import DcclBoundsError, check_dccl_bounds, field_bounds
+from translators.usv.validation import DcclBoundsError, check_dccl_bounds
 
 MAX_TEXT = 10_000  # characters accepted for one string or bytes value without (dccl.field).max_length
 
@@ -107,11 +109,13 @@ def _check_limits(field: FieldDescriptor, value: Any, path: str) -> None:
         if len(value) > limit:
             raise CommandRefused(f"{path}: {len(value)} characters, more than the {limit} allowed", path)
         return
-    bounds = field_bounds(field)
+    bounds = dccl_bounds(field)
     if bounds is not None and isinstance(value, int | float) and not isinstance(value, bool):
-        rounded = bounds.quantize(value)
-        if not bounds.minimum <= rounded <= bounds.maximum:
-            raise CommandRefused(f"{path}: {value:g} is outside its DCCL bounds {bounds.describe()}", path)
+        low, high, step = bounds
+        rounded = math.floor(value / step + 0.5) * step  # DCCL rounds to the step, then checks
+        if not low <= rounded <= high:
+            raise CommandRefused(f"{path}: {value:g} is outside its DCCL bounds {describe_bounds(low, high, step)}",
+                                 path)
     elif field_kind(field) in ("float", "double"):
         low, high, _, _ = numeric_limits(field)
         if not low <= value <= high:
