@@ -82,6 +82,7 @@ class Behavior(ABC):
         self.post_mapping: dict[str, str] = {}
         self.now = 0.0
         self.completed = False
+        self.state_ok = True  # False once the behaviour posts BHV_ERROR this iteration: the helm halts
         self.state = ""
         self.outbox: list[Posting] = []
         self.last_update = ""
@@ -222,6 +223,15 @@ class Behavior(ABC):
             value = float(value)
         self.outbox.append(Posting(mapped, value, repeatable, key))
 
+    def post_warning(self, text: str) -> None:
+        """pHelmIvP's postWMessage: ``BHV_WARNING = <name>: <text>``, every time."""
+        self.post("BHV_WARNING", f"{self.name}: {text}", repeatable=True)
+
+    def post_error(self, text: str) -> None:
+        """pHelmIvP's postEMessage: ``BHV_ERROR = <name>: <text>``; the helm halts this iteration (BehaviorError)."""
+        self.post("BHV_ERROR", f"{self.name}: {text}", repeatable=True)
+        self.state_ok = False
+
     def post_flags(self, kind: str, repeatable: bool = True) -> None:
         if not self.flags[kind]:
             return
@@ -257,7 +267,7 @@ class Behavior(ABC):
         """(x, y, heading, speed) from the info buffer, or None with a BHV_ERROR if any is missing."""
         values = [self.info.get_double(v) for v in ("NAV_X", "NAV_Y", "NAV_HEADING", "NAV_SPEED")]
         if any(v is None for v in values):
-            self.post("BHV_ERROR", f"{self.name}: no ownship NAV_X/Y/HEADING/SPEED", repeatable=True)
+            self.post_error("ownship x,y,heading, or speed info not found.")
             return None
         return values[0], values[1], values[2], values[3]  # type: ignore[return-value]
 

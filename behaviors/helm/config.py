@@ -22,7 +22,7 @@ log = logging.getLogger(__name__)
 # effect here: dynamic behaviour libraries do not exist in this helm (docs/helm.md).
 _APP_PARAMS = {"apptick", "commstick", "maxapptick", "app_logging", "term_report_interval",
                "max_appcast_events", "deprecated_ok", "bhv_dir_not_found_ok", "seed_random", "verbose",
-               "ivp_behavior_dir", "ivp_behavior_dirs", "pmgen", "contact_max_age", "node_skew",
+               "ivp_behavior_dir", "ivp_behavior_dirs", "pmgen", "contact_max_age",
                "hold_on_app", "hold_on_apps"}
 
 
@@ -45,6 +45,7 @@ class HelmConfig:
     time_warp: float = 1.0
     lat_origin: float | None = None
     long_origin: float | None = None
+    node_skews: dict[str, float] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
 
     @classmethod
@@ -92,6 +93,11 @@ class HelmConfig:
             if not is_number(value):
                 raise ParamError(f"nav_grace must be a number, not '{value}'")
             self.nav_grace = float(value)
+        elif key == "node_skew":
+            vname, _, skew = (part.strip() for part in value.partition(","))
+            if not vname or not is_number(skew) or vname in self.node_skews:
+                raise ParamError(f"node_skew must be VNAME,SECONDS, once per vehicle, not '{value}'")
+            self.node_skews[vname] = float(skew)
         elif key == "standby":
             raise ParamError("standby helms are not supported by this helm")
         elif key in _APP_PARAMS:

@@ -30,6 +30,7 @@ class EngineResult:
     states: dict[str, str] = field(default_factory=dict)
     removed: list[str] = field(default_factory=list)
     modes: dict[str, str] = field(default_factory=dict)
+    halted: str = ""  # the BHV_ERROR that halted this iteration (no decision), "" if none
 
 
 class HelmEngine:
@@ -43,6 +44,7 @@ class HelmEngine:
         self.iteration = 0
         self._last_posted: dict[str, Value] = {}
         self._configured: set[str] = set()
+        self._last_halt = ""
 
     def clear_post_filter(self) -> None:
         """HELM_MAP_CLEAR: forget what was posted so everything is posted again."""
@@ -60,8 +62,10 @@ class HelmEngine:
                 self._posted_modes[var] = value
                 extra.append(Posting(var, typed, key="mode_set"))
         states: dict[str, str] = {}
+        halted = ""
         for bhv in self.behaviors:
             bhv.now = now
+            bhv.state_ok = True
             extra.extend(self._apply_updates(bhv, now))
             fn = self._step(bhv, now)
             states[bhv.name] = bhv.state
@@ -71,7 +75,17 @@ class HelmEngine:
                                    f"state={bhv.state},updates={good}/{total}", key="status")
             if fn is not None and bhv.pwt > 0:
                 functions.append(fn)
-        decisions = solve(self.domain, functions)
+            if not bhv.state_ok:  # pHelmIvP halts: the later behaviours are not run, nothing is decided
+                errors = [p.value for p in bhv.outbox if p.var == "BHV_ERROR"]
+                halted = str(errors[-1]) if errors else f"{bhv.name}: unknown error"
+                break
+        if halted != self._last_halt:  # log each new halt once, not every iteration it lasts
+            if halted:
+                log.warning("helm halted (no decision while this lasts): BHV_ERROR %s", halted)
+            else:
+                log.info("helm no longer halted")
+            self._last_halt = halted
+        decisions = {} if halted else solve(self.domain, functions)
         self.info.clear_deltas()
         postings = extra
         removed: list[str] = []
@@ -84,7 +98,7 @@ class HelmEngine:
                                         f"iter={self.iteration},time={fmt_num(now, 2)},bname={bhv.name},"
                                         f"btype={bhv.TYPE},event=death", repeatable=True))
         self.behaviors = [b for b in self.behaviors if b.name not in removed]
-        return EngineResult(decisions, len(functions), postings, states, removed, modes)
+        return EngineResult(decisions, len(functions), postings, states, removed, modes, halted)
 
     def _apply_updates(self, bhv: Behavior, now: float) -> list[Posting]:
         results: list[Posting] = []

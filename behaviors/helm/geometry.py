@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from translators.node_report_codec import double_to_string_x
+
 Point = tuple[float, float]
 
 
@@ -132,9 +134,4 @@ class Polygon:
         return "pts={" + ":".join(f"{fmt_num(x)},{fmt_num(y)}" for x, y in self.vertices) + "}"
 
 
-def fmt_num(value: float, digits: int = 3) -> str:
-    """MBUtils' doubleToStringX: fixed digits with trailing zeros (and a bare point) removed."""
-    text = f"{value:.{digits}f}"
-    if "." in text:
-        text = text.rstrip("0").rstrip(".")
-    return "0" if text in ("-0", "") else text
+fmt_num = double_to_string_x  # MBUtils' doubleToStringX; one implementation, in the node-report codec

@@ -9,10 +9,14 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 
+from translators.node_report_codec import NodeReportError
+from util.geodesy import UTMGeodesy
+
 from .behavior import Behavior
 from .bhv_file import Initialize, build_behaviors, read_bhv_file
 from .config import HelmConfig
-from .engine import HelmEngine
+from .contacts import NODE_REPORT_VARS, ContactTable
+from .engine import EngineResult, HelmEngine
 from .errors import BehaviorFileError
 from .geometry import fmt_num
 from .info_buffer import InfoBuffer, Value
@@ -22,7 +26,8 @@ log = logging.getLogger(__name__)
 
 OVERRIDE_VARS = ("MOOS_MANUAL_OVERIDE", "MOOS_MANUAL_OVERRIDE")
 NAV_VARS = ("NAV_X", "NAV_Y", "NAV_HEADING", "NAV_SPEED")
-FIXED_REGISTRATIONS = (*OVERRIDE_VARS, *NAV_VARS, "NAV_DEPTH", "IVPHELM_STATE", "HELM_MAP_CLEAR", "DB_CLIENTS")
+FIXED_REGISTRATIONS = (*OVERRIDE_VARS, *NAV_VARS, "NAV_DEPTH", "IVPHELM_STATE", "HELM_MAP_CLEAR", "DB_CLIENTS",
+                       *NODE_REPORT_VARS)
 GRACE_ALLSTOPS = ("NothingToDo", "MissingDecVars", "NoGoalBehavior")
 
 
@@ -42,6 +47,13 @@ class Helm:
         self.config, self.app_name, self.ownship = config, app_name, ownship
         self.info = InfoBuffer()
         self.problems = list(config.problems)
+        geodesy = None
+        if config.lat_origin is not None and config.long_origin is not None:
+            try:
+                geodesy = UTMGeodesy(config.lat_origin, config.long_origin)
+            except ValueError as exc:
+                self.problems.append(f"LatOrigin/LongOrigin: {exc}")
+        self.contacts = ContactTable(self.info, geodesy, config.node_skews)
         self.initializes: list[Initialize] = []
         behaviors: list[Behavior] = []
         modes: list[ModeEntry] = []
@@ -68,6 +80,7 @@ class Helm:
         self._deferred_done = False
         self._nav_warned = False
         self._bhv_lists: dict[str, str] = {}
+        self._report_warned: dict[str, float] = {}  # "var|source|reason" -> helm time of the last warning
         self._outbox: list[Post] = []
 
     # ---- interface to the MOOS app --------------------------------------------------------------
@@ -126,6 +139,8 @@ class Helm:
                 self.state = "DISABLED"
         elif var == "HELM_MAP_CLEAR":
             self.engine.clear_post_filter()
+        elif var in NODE_REPORT_VARS:
+            self._handle_node_report(var, value, source, now)
         self.info.set(var, value)
         return out
 
@@ -161,13 +176,15 @@ class Helm:
         out.extend(self._behavior_lists(result.states))
         self.last_decisions = result.decisions
         missing = [v.name for v in self.config.domain.vars.values() if v.name not in result.decisions and not v.optional]
-        if result.function_count == 0:
+        if result.halted:
+            message = "BehaviorError"
+        elif result.function_count == 0:
             message = "NothingToDo"
         elif missing:
             message = "MissingDecVars:" + ",".join(missing)
         else:
             message = "clear"
-        out.append(Post("IVPHELM_SUMMARY", self._summary(result.decisions, result.states, result.modes)))
+        out.append(Post("IVPHELM_SUMMARY", self._summary(result)))
         out.extend(self._all_stop(message))
         if message == "clear":
             for var, value in result.decisions.items():
@@ -175,6 +192,22 @@ class Helm:
         return out
 
     # ---- internals ------------------------------------------------------------------------------
+    def _handle_node_report(self, var: str, value: Value, source: str, now: float) -> None:
+        """pHelmIvP's processNodeReport: ``<NAME>_NAV_*`` into the info buffer; a bad report is logged, unused.
+
+        The same fault from the same sender is logged at most once a minute (helm time); repeats go to debug.
+        """
+        try:
+            if not isinstance(value, str):
+                raise NodeReportError("a node report must be a string, not a number")
+            self.contacts.handle_report(value)
+        except NodeReportError as exc:
+            key = f"{var}|{source}|{exc}"
+            last = self._report_warned.get(key)
+            level = logging.DEBUG if last is not None and now - last < 60.0 else logging.WARNING
+            if level == logging.WARNING:
+                self._report_warned[key] = now
+            log.log(level, "unhandled %s from %s: %s (report '%s')", var, source, exc, value)
     def _deferred_initializes(self, now: float) -> list[Post]:
         if self._deferred_done or not self._seen_own_state:
             return []
@@ -214,15 +247,18 @@ class Helm:
                 out.append(Post(f"IVPHELM_BHV_{kind.upper()}_CNT", float(len(names.split(",")) if names else 0)))
         return out
 
-    def _summary(self, decisions: dict[str, float], states: dict[str, str], modes: dict[str, str]) -> str:
+    def _summary(self, result: EngineResult) -> str:
         def listed(kind: str) -> str:
-            return ":".join(n for n, s in states.items() if s == kind) or "none"
+            return ":".join(n for n, s in result.states.items() if s == kind) or "none"
 
         parts = [f"iter={self.engine.iteration}"]
-        parts += [f"var={var}:{fmt_num(value)}" for var, value in decisions.items()]
-        mode_text = "#".join(f"{var}@{value}" for var, value in modes.items()) or "none"
+        parts += [f"var={var}:{fmt_num(value)}" for var, value in result.decisions.items()]
+        parts.append(f"halted={'true' if result.halted else 'false'}")
+        mode_text = "#".join(f"{var}@{value}" for var, value in result.modes.items()) or "none"
         parts += [f"modes={mode_text}", f"active_bhvs={listed('active')}", f"running_bhvs={listed('running')}",
                   f"idle_bhvs={listed('idle')}", f"completed_bhvs={listed('completed')}"]
+        if result.halted:
+            parts.append(f'halt_msg="BHV_ERROR: {result.halted}"')
         return ",".join(parts)
 
 

@@ -1,7 +1,9 @@
-"""The IvP domain, ZAIC_PEAK objective functions, and the per-variable grid solver (spec §6).
+"""The IvP domain, ZAIC_PEAK objective functions, and the grid solver (spec §6).
 
-Every behaviour here builds a separable function (a sum of one-variable pieces), so the weighted sum
-over behaviours is maximised one decision variable at a time over that variable's grid.
+Most behaviours build a separable function (a sum of one-variable pieces), so the weighted sum over behaviours is
+maximised one decision variable at a time over that variable's grid. A function that couples two variables (BHV_Trail's
+CPA-based approach, AOF_CutRangeCPA) comes as a table over both grids; those two variables are then maximised
+together over the product grid, the separable pieces of the other behaviours added in.
 """
 
 from __future__ import annotations
@@ -128,10 +130,20 @@ def normalise(values: list[float], top: float) -> list[float]:
 
 @dataclass
 class ObjectiveFunction:
-    """A separable IvP function: per variable, utilities on the grid (already weighted); times ``pwt``."""
+    """An IvP function times ``pwt``: per variable, utilities on the grid (already weighted), and optionally one
+    table ``joint = (var1, var2, rows)`` with ``rows[i][j]`` the utility at var1's i-th and var2's j-th grid value."""
 
     pwt: float
     pieces: dict[str, list[float]] = field(default_factory=dict)
+    joint: tuple[str, str, list[list[float]]] | None = None
+
+    @classmethod
+    def table(cls, pwt: float, var1: str, var2: str, rows: list[list[float]]) -> ObjectiveFunction:
+        """A function of two variables together, normalised to [0, 100] (``ipf->getPDMap()->normalize(0,100)``)."""
+        lo = min(min(row) for row in rows)
+        hi = max(max(row) for row in rows)
+        scale = 100.0 / (hi - lo) if hi > lo else 0.0
+        return cls(pwt, joint=(var1, var2, [[(u - lo) * scale for u in row] for row in rows]))
 
     @classmethod
     def single(cls, pwt: float, var: str, utilities: list[float]) -> ObjectiveFunction:
@@ -149,20 +161,60 @@ class ObjectiveFunction:
 
 
 def solve(domain: IvPDomain, functions: list[ObjectiveFunction]) -> dict[str, float]:
-    """Per decision variable, the grid value maximising Σ pwt·utility; ties go to the lowest grid index."""
+    """Per decision variable (or coupled pair), the grid value maximising Σ pwt·utility; ties go to the lowest
+    grid index (of the first variable, then the second, for a pair)."""
+    active = [fn for fn in functions if fn.pwt > 0]
+    pairs: list[tuple[str, str]] = []
+    for fn in active:
+        if fn.joint is not None and fn.joint[:2] not in pairs:
+            pairs.append(fn.joint[:2])
+    coupled = [name for pair in pairs for name in pair]
+    if len(coupled) != len(set(coupled)):
+        raise ValueError(f"a decision variable is coupled in two different tables: {pairs}")
     decisions: dict[str, float] = {}
     for name, var in domain.vars.items():
-        scores: list[float] | None = None
-        for fn in functions:
-            piece = fn.pieces.get(name)
-            if piece is None or fn.pwt <= 0:
-                continue
-            pwt = fn.pwt
-            if scores is None:
-                scores = [pwt * u for u in piece]
-            else:
-                scores = [s + pwt * u for s, u in zip(scores, piece, strict=True)]
+        if name in coupled:
+            continue
+        scores = _separable_scores(name, var, active)
         if scores is not None:
             best = max(range(var.points), key=scores.__getitem__)  # the first maximum: lowest index
             decisions[name] = var.low + best * var.delta
+    for name1, name2 in pairs:
+        var1, var2 = domain.vars[name1], domain.vars[name2]
+        total: list[list[float]] | None = None
+        for fn in active:
+            if fn.joint is not None and fn.joint[:2] == (name1, name2):
+                pwt = fn.pwt
+                if total is None:
+                    total = [[pwt * u for u in row] for row in fn.joint[2]]
+                else:
+                    total = [[t + pwt * u for t, u in zip(trow, urow, strict=True)]
+                             for trow, urow in zip(total, fn.joint[2], strict=True)]
+        assert total is not None  # every pair comes from some function's table
+        extra1 = _separable_scores(name1, var1, active)
+        extra2 = _separable_scores(name2, var2, active)
+        if extra1 is not None:
+            total = [[t + a for t in row] for row, a in zip(total, extra1, strict=True)]
+        if extra2 is not None:
+            total = [[t + b for t, b in zip(row, extra2, strict=True)] for row in total]
+        row_best = [max(row) for row in total]
+        best_i = row_best.index(max(row_best))  # the first maximum: lowest index of var1, then of var2
+        best_j = total[best_i].index(row_best[best_i])
+        decisions[name1] = var1.low + best_i * var1.delta
+        decisions[name2] = var2.low + best_j * var2.delta
     return decisions
+
+
+def _separable_scores(name: str, var: DomainVar, functions: list[ObjectiveFunction]) -> list[float] | None:
+    """Σ pwt·piece over the functions with a one-variable piece for ``name``; None if there is none."""
+    scores: list[float] | None = None
+    for fn in functions:
+        piece = fn.pieces.get(name)
+        if piece is None:
+            continue
+        pwt = fn.pwt
+        if scores is None:
+            scores = [pwt * u for u in piece]
+        else:
+            scores = [s + pwt * u for s, u in zip(scores, piece, strict=True)]
+    return scores

@@ -19,12 +19,13 @@ from .behavior import Behavior
 from .bhv_constant import ConstantDepthBehavior, ConstantHeadingBehavior, ConstantSpeedBehavior
 from .bhv_loiter import LoiterBehavior
 from .bhv_stationkeep import StationKeepBehavior
+from .bhv_trail import TrailBehavior
 from .bhv_waypoint import WaypointBehavior
 
 BEHAVIOR_TYPES: dict[str, type[Behavior]] = {
     cls.TYPE: cls
     for cls in (WaypointBehavior, LoiterBehavior, ConstantSpeedBehavior, ConstantHeadingBehavior,
-                ConstantDepthBehavior, StationKeepBehavior)
+                ConstantDepthBehavior, StationKeepBehavior, TrailBehavior)
 }
 
 BEHAVIOR_POINT = ExtensionPoint(group="ivp_helm.behaviors", what="helm behaviour", source="a .bhv file",

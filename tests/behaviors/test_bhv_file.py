@@ -120,7 +120,8 @@ def test_brace_placement_and_line_continuation() -> None:
 
 
 BAD = [
-    ("Behavior = BHV_Trail\n{\n name = t\n}\n", 1, "BHV_Trail", "unknown behaviour type"),
+    ("Behavior = BHV_AvoidCollision\n{\n name = t\n}\n", 1, "BHV_AvoidCollision", "unknown behaviour type"),
+    ("Behavior = BHV_Trail\n{\n name = t\n}\n", 1, "BHV_Trail", "contact is not set"),
     ("Behavior = BHV_Waypoint\n{\n name = w\n speeed = 2\n}\n", 4, "speeed", "unknown parameter"),
     ("Behavior = BHV_Waypoint\n{\n name = w\n speed = fast\n}\n", 4, "speed = fast", "must be a number"),
     ("Behavior = BHV_Waypoint\n{\n name = w\n points = 1,2:3\n}\n", 4, "points = 1,2:3", "bad vertex"),

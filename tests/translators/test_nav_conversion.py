@@ -9,7 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus, Source
-from translators.frontseat.nav_conversion import format_g15, format_report_number, nav_posts, node_report
+from translators.frontseat.nav_conversion import format_g15, nav_posts, node_report
+from translators.node_report_codec import course_number
 from util.geodesy import UTMGeodesy
 
 # ivp_helm.md §7.3: origin 43.8253, -70.3304 (zone 19T); (x, y) <-> (lat, lon) from pyproj/PROJ and a Gantz port.
@@ -154,12 +155,14 @@ def test_node_report_heading_is_always_in_0_360(heading):
 
 @pytest.mark.parametrize(
     ("value", "text"),
-    [(-9.31322574615479e-10, "0"), (200.000000000407, "200"), (-0.0, "0"), (1.25, "1.25"), (-40.0001234, "-40"),
+    [(-9.31322574615479e-10, "0"), (200.000000000407, "200"), (-0.0, "-0"), (1.25, "1.25"), (-40.0001234, "-40"),
      (12.3456, "12.346"), (1e20, "100000000000000000000")],
 )
 def test_report_numbers_never_use_exponents(value, text):
-    """pHelmIvP drops a whole NODE_REPORT whose number reads like -9.3e-10 (checked against the real helm)."""
-    assert format_report_number(value) == text
+    """pHelmIvP drops a whole NODE_REPORT whose number reads like -9.3e-10 (checked against the real helm).
+
+    An exact -0.0 prints ``-0`` as the course's C++ stream does (its ``DEPTH = -z`` for a surface vehicle)."""
+    assert course_number(value) == text
 
 
 def test_heading_just_below_360_reports_0():

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus, Source, VehicleType
+from translators.node_report_codec import NodeReport, format_course_report
 from util.geodesy import UTMGeodesy
 
 MoosValue = float | str
@@ -18,19 +19,6 @@ MoosPost = tuple[str, MoosValue]
 def format_g15(value: float) -> str:
     """A number as a C++ stream prints it after ``std::setprecision(15)`` (``%.15g``), as Goby writes times."""
     return f"{value:.15g}"
-
-
-def format_report_number(value: float) -> str:
-    """A NODE_REPORT number: rounded to 1e-3 and printed like ``%.15g``, but never in exponent form.
-
-    pHelmIvP's report parser rejects the whole report when a number reads ``-9.3e-10`` (as ``%.15g`` prints a
-    y of almost zero); the course never hit this because its values were DCCL-quantized to 0.1 m / 1 degree.
-    """
-    rounded = round(value, 3) + 0.0  # + 0.0 turns -0.0 into 0.0
-    text = f"{rounded:.15g}"
-    if "e" in text:  # only for |value| >= 1e15 after rounding
-        text = f"{rounded:.3f}".rstrip("0").rstrip(".")
-    return text
 
 
 def local_xy(status: NodeStatus, geodesy: UTMGeodesy | None) -> tuple[float, float]:
@@ -88,36 +76,13 @@ def vehicle_type_name(status: NodeStatus) -> str:
     return VehicleType.Name(status.type)
 
 
-def normalized_heading(degrees: float) -> float:
-    """``degrees`` in [0, 360): a tiny negative angle must not round up to 360 once shifted."""
-    heading = math.fmod(degrees, 360.0)
-    if heading < 0.0:
-        heading += 360.0
-        if heading >= 360.0:
-            heading = 0.0
-    return heading + 0.0  # turns -0.0 into 0.0
-
-
 def node_report(status: NodeStatus, geodesy: UTMGeodesy | None = None, name: str | None = None) -> str:
-    """A NODE_REPORT line in the Goby3 course's format, which pHelmIvP's contact parser accepts.
+    """A NODE_REPORT line in the Goby3 course's format (:func:`translators.node_report_codec.format_course_report`).
 
-    ``NAME=..,TYPE=..,TIME=..,X=..,Y=..,DEPTH=..,HDG=..,SPD=..``; every number is printed with 15 significant
-    digits because the course sets the stream precision just before TIME and it sticks; X, Y, DEPTH, HDG and SPD
-    are first rounded to 1e-3 so that they never print in exponent form (see :func:`format_report_number`).
-    HDG is normalised to [0, 360) as the course's nav conversion does. NAME is ``name`` if given, else the status's name, else its
-    type name.
+    NAME is ``name`` if given, else the status's name, else its type name; DEPTH is the global fix's depth.
     """
     x, y = local_xy(status, geodesy)
-    vehicle_name = name or status.name or vehicle_type_name(status)
-    heading = normalized_heading(round(normalized_heading(status.pose.heading), 3))  # 359.9999 -> 0, not 360
-    fields = [
-        ("NAME", vehicle_name),
-        ("TYPE", vehicle_type_name(status)),
-        ("TIME", format_g15(status.time)),
-        ("X", format_report_number(x)),
-        ("Y", format_report_number(y)),
-        ("DEPTH", format_report_number(status.global_fix.depth)),
-        ("HDG", format_report_number(heading)),
-        ("SPD", format_report_number(status.speed.over_ground)),
-    ]
-    return ",".join(f"{key}={value}" for key, value in fields)
+    report = NodeReport(name=name or status.name or vehicle_type_name(status), type=vehicle_type_name(status),
+                        time=status.time, x=x, y=y, depth=status.global_fix.depth, heading=status.pose.heading,
+                        speed=status.speed.over_ground)
+    return format_course_report(report)
