@@ -33,21 +33,23 @@ LongOrigin = -70.330400
 
 ProcessConfig = pHelmIvP
 {{
-  AppTick    = 4
+  AppTick    = {app_tick}
   CommsTick  = 4
   bhv_dir_not_found_ok = true
   behaviors  = {bhv}
   domain     = course:0:359:360
   domain     = speed:0:{max_speed}:41
 {extra}}}
-"""
+{blocks}"""
 
 
 def write_mission(tmp_path: Path, port: int, bhv: Path, warp: float = WARP, community: str = "alpha",
-                  max_speed: str = "2", extra: str = "") -> Path:
-    path = tmp_path / "mission.moos"
+                  max_speed: str = "2", extra: str = "", app_tick: float = 4, blocks: str = "",
+                  name: str = "mission.moos") -> Path:
+    """The mission file: ``extra`` lines go into the pHelmIvP block, ``blocks`` (other ProcessConfigs) after it."""
+    path = tmp_path / name
     path.write_text(MISSION.format(port=port, warp=warp, bhv=bhv, community=community, max_speed=max_speed,
-                                   extra=extra))
+                                   extra=extra, app_tick=f"{app_tick:g}", blocks=blocks))
     return path
 
 

@@ -19,31 +19,14 @@ from gateway.moos.testing import moosdb_process
 from launch.config import render
 
 from .acomms_link_double import AcommsLinkDouble
-from .moos_harness import REPO, helm_process, observer, vehicle
+from .moos_harness import REPO, helm_process, observer, vehicle, write_mission
 
 WARP = 20.0
 SETTLE_S, MEASURE_S, RECOVER_S = 150.0, 300.0, 120.0
 N_AUVS = 2
 NODE_REPORTER = Path(sys.executable).parent / "node-reporter"
 
-MOOS = """\
-ServerHost = 127.0.0.1
-ServerPort = {port}
-Community  = {community}
-MOOSTimeWarp = {warp}
-LatOrigin  = 43.8253
-LongOrigin = -70.3304
-
-ProcessConfig = pHelmIvP
-{{
-  AppTick   = 1
-  CommsTick = 4
-  bhv_dir_not_found_ok = true
-  behaviors = {bhv}
-  domain    = course:0:359:360
-  domain    = speed:0:{max_speed}:41
-{depth}}}
-
+REPORTER_BLOCK = """
 ProcessConfig = pNodeReporter
 {{
   AppTick   = 4
@@ -52,6 +35,7 @@ ProcessConfig = pNodeReporter
   platform_length = 4
 }}
 """
+DEPTH_DOMAIN = "  domain     = depth:0:200:201\n"
 
 USV_LINE = """\
 initialize MOOS_MANUAL_OVERRIDE = false
@@ -73,13 +57,11 @@ def auv_values(index: int, n: int = N_AUVS) -> dict[str, float]:
     return {"trail_angle": 90 + (270 - 90) / (n - 1) * index, "deploy_depth": 10 + 10 * index}
 
 
-def write_mission(directory: Path, port: int, community: str, bhv: Path, auv: bool) -> Path:
-    directory.mkdir(parents=True, exist_ok=True)
-    path = directory / f"{community}.moos"
-    path.write_text(MOOS.format(port=port, community=community, warp=WARP, bhv=bhv, max_speed=4 if auv else 2,
-                                depth="  domain    = depth:0:200:201\n" if auv else "",
-                                vtype="auv" if auv else "usv"))
-    return path
+def auv_mission(directory: Path, port: int, community: str, bhv: Path, auv: bool, warp: float = WARP) -> Path:
+    """The course's AUV (or USV) .moos: helm at AppTick 1 (depth domain for an AUV) and a pNodeReporter block."""
+    return write_mission(directory, port, bhv, warp, community, max_speed="4" if auv else "2",
+                         extra=DEPTH_DOMAIN if auv else "", app_tick=1, name=f"{community}.moos",
+                         blocks=REPORTER_BLOCK.format(vtype="auv" if auv else "usv"))
 
 
 @contextlib.contextmanager
@@ -91,7 +73,7 @@ def vehicle_stack(tmp_path: Path, community: str, bhv_text: str, auv: bool, cloc
     bhv = directory / f"{community}.bhv"
     bhv.write_text(bhv_text)
     with moosdb_process(directory, community, WARP) as db:
-        mission = write_mission(directory, db.port, community, bhv, auv)
+        mission = auv_mission(directory, db.port, community, bhv, auv)
         with contextlib.ExitStack() as stack:
             stack.enter_context(helm_process(mission, directory))
             if not auv:
