@@ -24,8 +24,10 @@ import re
 from dataclasses import dataclass, field
 from decimal import Decimal
 
+from translators.errors import TranslatorError
 
-class NodeReportError(ValueError):
+
+class NodeReportError(TranslatorError, ValueError):
     """A node report that cannot be parsed or formatted; the message names the field and the reason."""
 
 
