@@ -27,7 +27,7 @@ from gateway.goby.protobuf import interprocess_config_pb2 as gateway_dot_goby_do
 from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as dccl_dot_option__extensions__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n$tests/protobuf/sample_messages.proto\x12\x19goby.test.zeromq.protobuf\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\x1a\x1c\x64\x63\x63l/option_extensions.proto\"n\n\x06Sample\x12\t\n\x01\x61\x18\x01 \x01(\x05\x12\x13\n\x0btemperature\x18\x02 \x01(\x01\x12\x10\n\x08salinity\x18\x03 \x01(\x01\x12\r\n\x05\x64\x65pth\x18\x04 \x01(\x01\x12\x12\n\nsent_micro\x18\x05 \x01(\x03\x12\x0f\n\x07padding\x18\x06 \x01(\x0c\"\x13\n\x06Widget\x12\t\n\x01\x62\x18\x01 \x01(\x05\"9\n\nDCCLSample\x12 \n\x01\x61\x18\x01 \x02(\x05\x42\x15\xa2?\x12\x31\x00\x00\x00\x00\x00\x00\x00\x00\x39\x00\x00\x00\x00\x00@\x8f@:\t\xa2?\x06\x08|\x10 (\x03\"\xdd\x01\n\x0fSampleAppConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x12\n\x04role\x18\x03 \x01(\t:\x04\x65\x63ho\x12\x11\n\x05\x63ount\x18\x04 \x01(\x05:\x02\x31\x30\x12\r\n\x05group\x18\x05 \x03(\t\x12\x1c\n\x0epublish_period\x18\x06 \x01(\x01:\x04\x30.05')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n$tests/protobuf/sample_messages.proto\x12\x19goby.test.zeromq.protobuf\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\x1a\x1c\x64\x63\x63l/option_extensions.proto\"n\n\x06Sample\x12\t\n\x01\x61\x18\x01 \x01(\x05\x12\x13\n\x0btemperature\x18\x02 \x01(\x01\x12\x10\n\x08salinity\x18\x03 \x01(\x01\x12\r\n\x05\x64\x65pth\x18\x04 \x01(\x01\x12\x12\n\nsent_micro\x18\x05 \x01(\x03\x12\x0f\n\x07padding\x18\x06 \x01(\x0c\"\x13\n\x06Widget\x12\t\n\x01\x62\x18\x01 \x01(\x05\"9\n\nDCCLSample\x12 \n\x01\x61\x18\x01 \x02(\x05\x42\x15\xa2?\x12)\x00\x00\x00\x00\x00\x00\x00\x00\x31\x00\x00\x00\x00\x00@\x8f@:\t\xa2?\x06\x08|\x10 (\x03\"\xdd\x01\n\x0fSampleAppConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x12\n\x04role\x18\x03 \x01(\t:\x04\x65\x63ho\x12\x11\n\x05\x63ount\x18\x04 \x01(\x05:\x02\x31\x30\x12\r\n\x05group\x18\x05 \x03(\t\x12\x1c\n\x0epublish_period\x18\x06 \x01(\x01:\x04\x30.05')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
@@ -35,7 +35,7 @@ _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'tests.protobuf.sample_messa
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
   _globals['_DCCLSAMPLE'].fields_by_name['a']._loaded_options = None
-  _globals['_DCCLSAMPLE'].fields_by_name['a']._serialized_options = b'\242?\0221\000\000\000\000\000\000\000\0009\000\000\000\000\000@\217@'
+  _globals['_DCCLSAMPLE'].fields_by_name['a']._serialized_options = b'\242?\022)\000\000\000\000\000\000\000\0001\000\000\000\000\000@\217@'
   _globals['_DCCLSAMPLE']._loaded_options = None
   _globals['_DCCLSAMPLE']._serialized_options = b'\242?\006\010|\020 (\003'
   _globals['_SAMPLE']._serialized_start=186

@@ -25,7 +25,7 @@ _sym_db = _symbol_database.Default()
 from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as dccl_dot_option__extensions__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n+translators/usv/protobuf/command_dccl.proto\x12\x11goby3_course.dccl\x1a\x1c\x64\x63\x63l/option_extensions.proto\"\x9d\x02\n\nUSVCommand\x12&\n\x04time\x18\x01 \x02(\x01\x42\x18\xa2?\x15\n\ndccl.time2\xf2\x01\x06\x12\x04time\x12\x42\n\rdesired_state\x18\x02 \x02(\x0e\x32+.goby3_course.dccl.USVCommand.AutonomyState\x12,\n\rpolygon_sides\x18\x03 \x01(\x05\x42\x15\xa2?\x12\x31\x00\x00\x00\x00\x00\x00\x08@9\x00\x00\x00\x00\x00\x00$@\x12\x38\n\x0epolygon_radius\x18\x04 \x01(\x05\x42 \xa2?\x1d \xff\xff\xff\xff\xff\xff\xff\xff\xff\x01\x31\x00\x00\x00\x00\x00\x00Y@9\x00\x00\x00\x00\x00@\x9f@\"+\n\rAutonomyState\x12\r\n\tWAYPOINTS\x10\x01\x12\x0b\n\x07POLYGON\x10\x02:\x0e\xa2?\x0b\x08~\x10 (\x03\xf2\x01\x02si')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n+translators/usv/protobuf/command_dccl.proto\x12\x11goby3_course.dccl\x1a\x1c\x64\x63\x63l/option_extensions.proto\"\x9d\x02\n\nUSVCommand\x12&\n\x04time\x18\x01 \x02(\x01\x42\x18\xa2?\x15\n\ndccl.time2\xf2\x01\x06\x12\x04time\x12\x42\n\rdesired_state\x18\x02 \x02(\x0e\x32+.goby3_course.dccl.USVCommand.AutonomyState\x12,\n\rpolygon_sides\x18\x03 \x01(\x05\x42\x15\xa2?\x12)\x00\x00\x00\x00\x00\x00\x08@1\x00\x00\x00\x00\x00\x00$@\x12\x38\n\x0epolygon_radius\x18\x04 \x01(\x05\x42 \xa2?\x1d \xff\xff\xff\xff\xff\xff\xff\xff\xff\x01)\x00\x00\x00\x00\x00\x00Y@1\x00\x00\x00\x00\x00@\x9f@\"+\n\rAutonomyState\x12\r\n\tWAYPOINTS\x10\x01\x12\x0b\n\x07POLYGON\x10\x02:\x0e\xa2?\x0b\x08~\x10 (\x03\xf2\x01\x02si\"\xb1\x01\n\nAUVCommand\x12&\n\x04time\x18\x01 \x02(\x01\x42\x18\xa2?\x15\n\ndccl.time2\xf2\x01\x06\x12\x04time\x12\x42\n\rdesired_state\x18\x02 \x02(\x0e\x32+.goby3_course.dccl.AUVCommand.AutonomyState\"\'\n\rAutonomyState\x12\t\n\x05TRAIL\x10\x01\x12\x0b\n\x07RECOVER\x10\x02:\x0e\xa2?\x0b\x08\x7f\x10 (\x03\xf2\x01\x02si')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
@@ -35,13 +35,21 @@ if not _descriptor._USE_C_DESCRIPTORS:
   _globals['_USVCOMMAND'].fields_by_name['time']._loaded_options = None
   _globals['_USVCOMMAND'].fields_by_name['time']._serialized_options = b'\242?\025\n\ndccl.time2\362\001\006\022\004time'
   _globals['_USVCOMMAND'].fields_by_name['polygon_sides']._loaded_options = None
-  _globals['_USVCOMMAND'].fields_by_name['polygon_sides']._serialized_options = b'\242?\0221\000\000\000\000\000\000\010@9\000\000\000\000\000\000$@'
+  _globals['_USVCOMMAND'].fields_by_name['polygon_sides']._serialized_options = b'\242?\022)\000\000\000\000\000\000\010@1\000\000\000\000\000\000$@'
   _globals['_USVCOMMAND'].fields_by_name['polygon_radius']._loaded_options = None
-  _globals['_USVCOMMAND'].fields_by_name['polygon_radius']._serialized_options = b'\242?\035 \377\377\377\377\377\377\377\377\377\0011\000\000\000\000\000\000Y@9\000\000\000\000\000@\237@'
+  _globals['_USVCOMMAND'].fields_by_name['polygon_radius']._serialized_options = b'\242?\035 \377\377\377\377\377\377\377\377\377\001)\000\000\000\000\000\000Y@1\000\000\000\000\000@\237@'
   _globals['_USVCOMMAND']._loaded_options = None
   _globals['_USVCOMMAND']._serialized_options = b'\242?\013\010~\020 (\003\362\001\002si'
+  _globals['_AUVCOMMAND'].fields_by_name['time']._loaded_options = None
+  _globals['_AUVCOMMAND'].fields_by_name['time']._serialized_options = b'\242?\025\n\ndccl.time2\362\001\006\022\004time'
+  _globals['_AUVCOMMAND']._loaded_options = None
+  _globals['_AUVCOMMAND']._serialized_options = b'\242?\013\010\177\020 (\003\362\001\002si'
   _globals['_USVCOMMAND']._serialized_start=97
   _globals['_USVCOMMAND']._serialized_end=382
   _globals['_USVCOMMAND_AUTONOMYSTATE']._serialized_start=323
   _globals['_USVCOMMAND_AUTONOMYSTATE']._serialized_end=366
+  _globals['_AUVCOMMAND']._serialized_start=385
+  _globals['_AUVCOMMAND']._serialized_end=562
+  _globals['_AUVCOMMAND_AUTONOMYSTATE']._serialized_start=507
+  _globals['_AUVCOMMAND_AUTONOMYSTATE']._serialized_end=546
 # @@protoc_insertion_point(module_scope)

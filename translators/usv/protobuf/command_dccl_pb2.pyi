@@ -23,3 +23,17 @@ class USVCommand(_message.Message):
     polygon_sides: int
     polygon_radius: int
     def __init__(self, time: _Optional[float] = ..., desired_state: _Optional[_Union[USVCommand.AutonomyState, str]] = ..., polygon_sides: _Optional[int] = ..., polygon_radius: _Optional[int] = ...) -> None: ...
+
+class AUVCommand(_message.Message):
+    __slots__ = ("time", "desired_state")
+    class AutonomyState(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
+        __slots__ = ()
+        TRAIL: _ClassVar[AUVCommand.AutonomyState]
+        RECOVER: _ClassVar[AUVCommand.AutonomyState]
+    TRAIL: AUVCommand.AutonomyState
+    RECOVER: AUVCommand.AutonomyState
+    TIME_FIELD_NUMBER: _ClassVar[int]
+    DESIRED_STATE_FIELD_NUMBER: _ClassVar[int]
+    time: float
+    desired_state: AUVCommand.AutonomyState
+    def __init__(self, time: _Optional[float] = ..., desired_state: _Optional[_Union[AUVCommand.AutonomyState, str]] = ...) -> None: ...

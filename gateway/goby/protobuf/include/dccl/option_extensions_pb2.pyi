@@ -77,17 +77,19 @@ class DCCLFieldOptions(_message.Message):
     def __init__(self, codec: _Optional[str] = ..., omit: _Optional[bool] = ..., in_head: _Optional[bool] = ..., precision: _Optional[int] = ..., resolution: _Optional[float] = ..., min: _Optional[float] = ..., max: _Optional[float] = ..., num_days: _Optional[int] = ..., static_value: _Optional[str] = ..., max_length: _Optional[int] = ..., max_repeat: _Optional[int] = ..., min_repeat: _Optional[int] = ..., packed_enum: _Optional[bool] = ..., description: _Optional[str] = ..., units: _Optional[_Union[DCCLFieldOptions.Units, _Mapping]] = ..., dynamic_conditions: _Optional[_Union[DCCLFieldOptions.Conditions, _Mapping]] = ...) -> None: ...
 
 class DCCLMessageOptions(_message.Message):
-    __slots__ = ("id", "max_bytes", "codec", "codec_group", "codec_version", "unit_system")
+    __slots__ = ("id", "max_bytes", "codec", "codec_group", "codec_version", "omit_id", "unit_system")
     ID_FIELD_NUMBER: _ClassVar[int]
     MAX_BYTES_FIELD_NUMBER: _ClassVar[int]
     CODEC_FIELD_NUMBER: _ClassVar[int]
     CODEC_GROUP_FIELD_NUMBER: _ClassVar[int]
     CODEC_VERSION_FIELD_NUMBER: _ClassVar[int]
+    OMIT_ID_FIELD_NUMBER: _ClassVar[int]
     UNIT_SYSTEM_FIELD_NUMBER: _ClassVar[int]
     id: int
     max_bytes: int
     codec: str
     codec_group: str
     codec_version: int
+    omit_id: bool
     unit_system: str
-    def __init__(self, id: _Optional[int] = ..., max_bytes: _Optional[int] = ..., codec: _Optional[str] = ..., codec_group: _Optional[str] = ..., codec_version: _Optional[int] = ..., unit_system: _Optional[str] = ...) -> None: ...
+    def __init__(self, id: _Optional[int] = ..., max_bytes: _Optional[int] = ..., codec: _Optional[str] = ..., codec_group: _Optional[str] = ..., codec_version: _Optional[int] = ..., omit_id: _Optional[bool] = ..., unit_system: _Optional[str] = ...) -> None: ...
