@@ -29,7 +29,7 @@ def test_dccl_extensions_use_dccls_numbers_and_names():
     assert dccl_options.field.full_name == "dccl.field"
     assert dccl_options.msg.full_name == "dccl.msg"
     assert dccl_options.DCCLFieldOptions.DESCRIPTOR.fields_by_name["precision"].number == 4
-    assert dccl_options.DCCLFieldOptions.DESCRIPTOR.fields_by_name["min"].number == 6
+    assert dccl_options.DCCLFieldOptions.DESCRIPTOR.fields_by_name["min"].number == 5
     assert dccl_options.DCCLFieldOptions.DESCRIPTOR.fields_by_name["units"].number == 30
     assert dccl_options.DCCLMessageOptions.DESCRIPTOR.fields_by_name["unit_system"].number == 30
 
