@@ -202,15 +202,16 @@ class NumericCodec(InlineCodec):
             if _max_code(self) >= 1 << self.size:
                 good = f"({good}) & {hex((1 << self.size) - 1)}"
         else:
-            helper = "_f32e" if self.kind == "float" else None
+            helper = "f32e" if self.kind == "float" else None
             if self.kind == "int" and res == 1:
                 qmin = self._qmin()
                 check = f"{lo!r} <= {wire} <= {hi!r}"
-                good = f"{wire} - {qmin - null}" if qmin - null else wire
+                shift = qmin - null
+                good = f"{wire} - {shift}" if shift > 0 else f"{wire} + {-shift}" if shift < 0 else wire
                 if _max_code(self) >= 1 << self.size:
                     good = f"({good}) & {hex((1 << self.size) - 1)}"
             else:
-                helper = helper or "_inte"
+                helper = helper or "inte"
                 fn = src.bind(f32_encode if self.kind == "float" else int_encode, helper)
                 extra = "" if self.kind == "float" else f", {self.int_bits}, {self.signed}"
                 c = src.tmp("c")
@@ -242,12 +243,12 @@ class NumericCodec(InlineCodec):
                 wire = code if res == 1 else f"{code} * {res!r}" if res >= 1 else f"{code} / {1.0 / res!r}"
                 expr = _quantize_source(f"({wire} + {qmin!r})", res)
         elif self.kind == "float":
-            fn = src.bind(f32_decode, "_f32d")
+            fn = src.bind(f32_decode, "f32d")
             expr = f"{fn}({code}, {self.lower()!r}, {res!r})"
         elif res == 1 and _decoded_int_fits(self, qmin):
             expr = f"{code} + {qmin}" if qmin else code
         else:
-            fn = src.bind(int_decode, "_intd")
+            fn = src.bind(int_decode, "intd")
             expr = f"{fn}({code}, {self.lower()!r}, {res!r}, {self.int_bits}, {self.signed})"
         self.emit_post(src, expr, sink)
 
