@@ -236,7 +236,7 @@ def assert_close(decoded: Any, original: Any) -> None:
         if field.type == field.TYPE_MESSAGE:
             if field.is_repeated:
                 assert len(got) == len(value)
-                for a, b in zip(got, value):
+                for a, b in zip(got, value, strict=True):
                     assert_close(a, b)
             else:
                 assert_close(got, value)
