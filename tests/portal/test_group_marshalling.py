@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from gateway.goby.dccl import Codec as DcclCodec
 from gateway.goby.portal import Group, InvalidGroupError, MarshallingError, Scheme
 from gateway.goby.portal.group import INVALID_NUMERIC_GROUP, as_group, check_named
 from gateway.goby.portal.marshalling import (
@@ -18,6 +19,7 @@ from gateway.goby.portal.marshalling import (
     type_name,
 )
 from tests.protobuf.sample_messages_pb2 import DCCLSample, Sample
+from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 
 
 def test_group_wire_strings() -> None:
@@ -86,3 +88,19 @@ def test_dccl_messages_default_to_dccl_but_travel_as_protobuf_on_interprocess() 
     assert default_scheme(DCCLSample) == Scheme.DCCL
     assert interprocess_scheme(DCCLSample) == Scheme.PROTOBUF
     assert interprocess_scheme(str) == Scheme.CSTR
+
+
+def test_dccl_marshalling_is_exactly_the_dccl_bytes() -> None:
+    """Scheme DCCL: the payload is the DCCL encoding (the C++ codec's bytes for this USVCommand: fc80380100)."""
+    codec = DcclCodec(clock=lambda: 1700000000)
+    command = USVCommand(time=1700000000, desired_state=USVCommand.WAYPOINTS)
+    data = serialize(command, Scheme.DCCL, codec)  # loads the type on first use, as Goby's serializer does
+    assert data.hex() == "fc80380100"
+    assert parse(data, Scheme.DCCL, USVCommand, codec) == command
+    assert parse_dynamic(data, Scheme.DCCL, "goby3_course.dccl.USVCommand", codec) == command
+    assert parse_dynamic(data, Scheme.DCCL, "goby3_course.dccl.USVCommand") == data  # no codec: raw bytes
+    with pytest.raises(MarshallingError, match="cannot DCCL-decode goby3_course.dccl.USVCommand: .*truncated"):
+        parse(data[:3], Scheme.DCCL, USVCommand, codec)
+    with pytest.raises(MarshallingError, match="cannot DCCL-encode goby.test.zeromq.protobuf.Sample: .*Missing "
+                                               "message option `\\(dccl.msg\\).id`"):
+        serialize(Sample(a=1), Scheme.DCCL, codec)

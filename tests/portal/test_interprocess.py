@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import logging
 import sys
+import time
 from pathlib import Path
 
 import pytest
 
+from gateway.goby.dccl import Codec as DcclCodec
 from gateway.goby.portal import Scheme
 from gateway.goby.portal.marshalling import parse_dynamic
 from gateway.goby.portal.testing import AppProcess, BrokerProcess, PortalClient, broker_process
 from tests.protobuf.sample_messages_pb2 import DCCLSample, Sample, Widget
+from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -170,3 +173,27 @@ def test_dccl_message_travels_as_protobuf(broker: BrokerProcess) -> None:
         assert client.poll_until(lambda: bool(typed) and bool(raw), 20)
     assert typed[0].a == 12
     assert raw == [(Scheme.PROTOBUF, "goby.test.zeromq.protobuf.DCCLSample")]
+
+
+def test_dccl_scheme_carries_the_dccl_bytes_between_processes(broker: BrokerProcess, tmp_path: Path) -> None:
+    """publish(..., scheme=DCCL): identifier ``/usv_command/DCCL/goby3_course.dccl.USVCommand/...`` and the DCCL
+    bytes as payload; a DCCL-scheme subscriber in another process decodes them."""
+    command = USVCommand(time=time.time() // 1, desired_state=USVCommand.POLYGON, polygon_sides=6,
+                         polygon_radius=300)
+    with PortalClient(broker.interprocess_config(), "dccl_scheme_rx") as rx:
+        typed = rx.collect("usv_command", USVCommand, scheme=Scheme.DCCL)
+        protobuf = rx.collect("usv_command", USVCommand)
+        raw: list[tuple[bytes, int, str]] = []
+        rx.portal.subscribe_regex(lambda d, s, t, g: raw.append((d, s, t)), group_regex="usv_command")
+        assert rx.wait_subscribed()
+        with PortalClient(broker.interprocess_config(), "dccl_scheme_tx") as tx:
+            assert tx.wait_ready()
+            tx.publish("usv_command", command, scheme=Scheme.DCCL)
+            tx.poll(0.1)
+        assert rx.poll_until(lambda: bool(typed) and bool(raw), 20)
+    assert typed == [command] and protobuf == []
+    payload, scheme, type_name = raw[0]
+    assert (scheme, type_name) == (Scheme.DCCL, "goby3_course.dccl.USVCommand")
+    codec = DcclCodec()
+    codec.load(USVCommand)
+    assert payload == codec.encode(command) and len(payload) == 5

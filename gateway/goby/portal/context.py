@@ -19,6 +19,7 @@ from typing import Any
 
 import zmq
 
+from gateway.goby.dccl import Codec as DcclCodec
 from gateway.goby.portal.interface_registry import InterfaceRegistry
 from gateway.goby.portal.interthread import InterThread
 from gateway.goby.portal.mailbox import Mailbox
@@ -60,6 +61,8 @@ class ProcessContext:
         self.registry = registry if registry is not None else InterfaceRegistry()
         self.hold_settle_s = hold_settle_s
         self.interthread = InterThread()
+        #: The process's DCCL codec (Goby keeps one per process): DCCL-scheme publications on interprocess.
+        self.dccl = DcclCodec()
         self.ready_flag = False
         self._hold_released = threading.Event()
         self._primary_claimed = False

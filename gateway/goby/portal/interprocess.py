@@ -40,7 +40,7 @@ from gateway.goby.portal.mailbox import Mailbox
 from gateway.goby.portal.manager_client import request_endpoints
 from gateway.goby.portal.marshalling import (
     Scheme,
-    default_scheme,
+    interprocess_scheme,
     parse,
     scheme_to_string,
     serialize,
@@ -134,7 +134,7 @@ class InterProcessPortal:
         self._check_open()
         group_text = self._group_text(group)
         sch, tname, key = self._type_info(type(msg), scheme)
-        self._publish_frame(group_text, sch, tname, serialize(msg, sch))
+        self._publish_frame(group_text, sch, tname, serialize(msg, sch, self._ctx.dccl))
         self._ctx.interthread.deliver(group_text, key, msg, self._mailbox)
 
     def _group_text(self, group: GroupLike) -> str:
@@ -147,12 +147,11 @@ class InterProcessPortal:
         return text
 
     def _type_info(self, msg_type: type, scheme: int | None) -> tuple[int, str, str]:
-        """(scheme, wire type name, interthread key) for a type; DCCL becomes PROTOBUF as in Goby."""
+        """(scheme, wire type name, interthread key) for a type; a default of DCCL becomes PROTOBUF as in Goby
+        (an explicit ``scheme=Scheme.DCCL`` sends the DCCL bytes)."""
         info = self._types.get((msg_type, scheme))
         if info is None:
-            sch = default_scheme(msg_type) if scheme is None else int(scheme)
-            if sch == Scheme.DCCL:
-                sch = Scheme.PROTOBUF
+            sch = interprocess_scheme(msg_type) if scheme is None else int(scheme)
             info = self._types[(msg_type, scheme)] = (sch, type_name(msg_type, sch), type_key(msg_type))
         return info
 
@@ -408,7 +407,7 @@ class InterProcessPortal:
                 msg = parsed.get(sub.msg_type)
                 if msg is None:
                     try:
-                        msg = parse(payload, sub.scheme, sub.msg_type)
+                        msg = parse(payload, sub.scheme, sub.msg_type, self._ctx.dccl)
                     except MarshallingError as exc:
                         log.error("%s: cannot decode publication on %s (%s): %s", self._thread_name, ident.group,
                                   ident.type_name, exc)

@@ -1,7 +1,10 @@
-"""Marshalling schemes with Goby's numeric ids, and protobuf/string (de)serialization.
+"""Marshalling schemes with Goby's numeric ids, and protobuf/DCCL/string (de)serialization.
 
-Wire type names: protobuf messages use the descriptor's ``full_name``; strings use ``CSTR`` and travel with a
-trailing NUL, as in Goby's ``cstr.h``.  A DCCL-annotated protobuf message travels as PROTOBUF on interprocess.
+Wire type names: protobuf messages use the descriptor's ``full_name`` (under PROTOBUF and DCCL alike); strings
+use ``CSTR`` and travel with a trailing NUL, as in Goby's ``cstr.h``. A DCCL-annotated protobuf message travels as
+PROTOBUF on interprocess unless published with ``scheme=Scheme.DCCL``; then the payload is exactly its DCCL bytes
+(Goby's ``SerializerParserHelper<T, DCCL>``), encoded by the process's DCCL codec, which loads each type on first
+use as Goby's does.
 """
 
 from __future__ import annotations
@@ -12,6 +15,8 @@ from typing import Any
 from google.protobuf import message as pb_message
 from google.protobuf import message_factory, symbol_database
 
+from gateway.goby.dccl import Codec as DcclCodec
+from gateway.goby.dccl import DcclError
 from gateway.goby.portal.errors import MarshallingError
 
 
@@ -69,7 +74,8 @@ def default_scheme(msg_type: type) -> int:
 
 
 def interprocess_scheme(msg_type: type) -> int:
-    """The scheme a type travels with on interprocess: DCCL becomes PROTOBUF."""
+    """The scheme a type travels with on interprocess by default: DCCL becomes PROTOBUF (an explicit scheme
+    is kept)."""
     scheme = default_scheme(msg_type)
     return Scheme.PROTOBUF if scheme == Scheme.DCCL else scheme
 
@@ -83,8 +89,14 @@ def type_name(msg_type: type, scheme: int) -> str:
     raise MarshallingError(f"cannot name {msg_type.__qualname__} under scheme {scheme_to_string(scheme)}")
 
 
-def serialize(msg: Any, scheme: int) -> bytes:
-    """Encode ``msg`` for the wire under ``scheme``."""
+def serialize(msg: Any, scheme: int, dccl: DcclCodec | None = None) -> bytes:
+    """Encode ``msg`` for the wire under ``scheme`` (DCCL needs the process's codec, ``dccl``)."""
+    if scheme == Scheme.DCCL and isinstance(msg, pb_message.Message) and dccl is not None:
+        try:
+            dccl.load(type(msg))
+            return dccl.encode(msg)
+        except DcclError as exc:
+            raise MarshallingError(f"cannot DCCL-encode {msg.DESCRIPTOR.full_name}: {exc}") from exc
     if scheme == Scheme.CSTR:
         data = msg.encode() if isinstance(msg, str) else bytes(msg)
         return data + b"\0"
@@ -96,8 +108,9 @@ def serialize(msg: Any, scheme: int) -> bytes:
     raise MarshallingError(f"cannot serialize {type(msg).__qualname__} as {scheme_to_string(scheme)}")
 
 
-def parse(data: bytes, scheme: int, msg_type: type) -> Any:
-    """Decode a payload into ``msg_type`` (``str`` for CSTR, drops the trailing NUL as Goby does)."""
+def parse(data: bytes, scheme: int, msg_type: type, dccl: DcclCodec | None = None) -> Any:
+    """Decode a payload into ``msg_type`` (``str`` for CSTR, drops the trailing NUL as Goby does; DCCL needs the
+    process's codec, ``dccl``)."""
     if scheme == Scheme.CSTR:
         raw = data[:-1] if data.endswith(b"\0") else data
         if issubclass(msg_type, bytes):
@@ -108,7 +121,13 @@ def parse(data: bytes, scheme: int, msg_type: type) -> Any:
             raise MarshallingError(f"CSTR payload is not UTF-8: {exc}") from exc
     if scheme in (Scheme.PROTOBUF, Scheme.DCCL) and issubclass(msg_type, pb_message.Message):
         if scheme == Scheme.DCCL:
-            raise MarshallingError(f"DCCL decoding of {msg_type.DESCRIPTOR.full_name} is not supported")
+            if dccl is None:
+                raise MarshallingError(f"no DCCL codec to decode {msg_type.DESCRIPTOR.full_name} with")
+            try:
+                dccl.load(msg_type)
+                return dccl.decode(data, msg_type)
+            except DcclError as exc:
+                raise MarshallingError(f"cannot DCCL-decode {msg_type.DESCRIPTOR.full_name}: {exc}") from exc
         msg = msg_type()
         try:
             msg.ParseFromString(data)
@@ -127,15 +146,16 @@ def message_class(full_name: str) -> type[pb_message.Message] | None:
     return message_factory.GetMessageClass(descriptor)
 
 
-def parse_dynamic(data: bytes, scheme: int, name: str) -> Any:
+def parse_dynamic(data: bytes, scheme: int, name: str, dccl: DcclCodec | None = None) -> Any:
     """Decode a payload whose type is known only by name (regex subscriptions).
 
-    Returns ``str`` for CSTR, the protobuf message when its type is known in this process, else the raw bytes.
+    Returns ``str`` for CSTR, the protobuf message when its type is known in this process (for DCCL, also given a
+    codec), else the raw bytes.
     """
     if scheme == Scheme.CSTR:
         return parse(data, scheme, str)
-    if scheme == Scheme.PROTOBUF:
+    if scheme == Scheme.PROTOBUF or (scheme == Scheme.DCCL and dccl is not None):
         cls = message_class(name)
         if cls is not None:
-            return parse(data, scheme, cls)
+            return parse(data, scheme, cls, dccl)
     return data
