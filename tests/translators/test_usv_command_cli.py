@@ -83,3 +83,9 @@ def test_example_config_needs_no_command(capsys):
     assert main(["--example_config"]) == 0
     out = capsys.readouterr().out
     assert "ack_timeout: 10" in out and "interprocess {" in out
+
+
+def test_a_radius_off_the_dccl_step_is_sent_rounded_with_a_notice(tmp_path):
+    result = run_cli(["polygon", "--sides", "6", "--radius", "304", "--interprocess", "no_such_field: 1"], {},
+                     tmp_path)  # stops at the bad option, after the command was checked
+    assert "note: USVCommand.polygon_radius=304 is sent as 300 (DCCL: [100, 2000], in steps of 10)" in result.stderr

@@ -1,4 +1,4 @@
-"""The course's USVCommand compiles with DCCL's options, and its DCCL bounds are enforced from the descriptor."""
+"""The course's USVCommand compiles with DCCL's options, and the USV command path enforces the DCCL codec's bounds."""
 
 from __future__ import annotations
 
@@ -11,9 +11,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from gateway.goby.dccl import Codec
 from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as dccl_options
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
-from translators.usv.validation import DcclBoundsError, check_dccl_bounds, dccl_message_options, field_bounds
+from translators.usv.validation import DcclBoundsError, check_dccl_bounds
 
 REPO = Path(__file__).resolve().parents[2]
 COURSE_PROTO = REPO / "translators" / "usv" / "protobuf" / "command_dccl.proto"
@@ -35,7 +36,7 @@ def test_dccl_extensions_use_dccls_numbers_and_names():
 
 
 def test_usv_command_message_options_and_fields():
-    options = dccl_message_options(USVCommand.DESCRIPTOR)
+    options = USVCommand.DESCRIPTOR.GetOptions().Extensions[dccl_options.msg]
     assert (options.id, options.max_bytes, options.codec_version, options.unit_system) == (126, 32, 3, "si")
     assert USVCommand.DESCRIPTOR.full_name == "goby3_course.dccl.USVCommand"
     numbers = {f.name: f.number for f in USVCommand.DESCRIPTOR.fields}
@@ -45,18 +46,26 @@ def test_usv_command_message_options_and_fields():
     assert time_options.codec == "dccl.time2" and time_options.units.derived_dimensions == "time"
 
 
-def test_bounds_are_read_from_the_descriptor():
-    sides = field_bounds(USVCommand.DESCRIPTOR.fields_by_name["polygon_sides"])
-    radius = field_bounds(USVCommand.DESCRIPTOR.fields_by_name["polygon_radius"])
-    assert (sides.minimum, sides.maximum, sides.resolution) == (3, 10, 1)
-    assert (radius.minimum, radius.maximum, radius.resolution) == (100, 2000, 10)
-    assert field_bounds(USVCommand.DESCRIPTOR.fields_by_name["time"]) is None
+def test_the_codec_reads_the_bounds_from_the_descriptor():
+    codec = Codec()
+    codec.load(USVCommand)
+    bounds = {b.name: b for b in codec.bounds(USVCommand)}
+    assert (bounds["polygon_sides"].min, bounds["polygon_sides"].max, bounds["polygon_sides"].resolution) == (3, 10, 1)
+    assert (bounds["polygon_radius"].min, bounds["polygon_radius"].max, bounds["polygon_radius"].resolution) == (
+        100, 2000, 10)
+    assert bounds["time"].time and bounds["time"].min is None
 
 
 @pytest.mark.parametrize(("sides", "radius", "sent"), [(3, 100, 100), (10, 2000, 2000), (6, 304, 300), (6, 305, 310), (6, 95, 100)])
 def test_in_bounds_values_pass_rounded_to_the_precision(sides, radius, sent):
-    checked = check_dccl_bounds(polygon(sides, radius))
+    notices: list[str] = []
+    checked = check_dccl_bounds(polygon(sides, radius), notices)
     assert (checked.polygon_sides, checked.polygon_radius) == (sides, sent)
+    assert checked.time == 1700000000.5  # the stamp identifies acknowledgements: kept as sent
+    if sent != radius:
+        assert notices == [f"USVCommand.polygon_radius={radius} is sent as {sent} (DCCL: [100, 2000], in steps of 10)"]
+    else:
+        assert notices == []
 
 
 @pytest.mark.parametrize(

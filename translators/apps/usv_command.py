@@ -110,11 +110,14 @@ def main(argv: list[str] | None = None) -> int:
         return run_application(lambda cfg: None, CommandTool, ["--example_config"], prog=PROG)
     parser = build_parser()
     args, goby_argv = parser.parse_known_args(argv)
+    notices: list[str] = []
     try:
-        command = check_dccl_bounds(build_command(args, 0.0))
+        command = check_dccl_bounds(build_command(args, 0.0), notices)
     except DcclBoundsError as error:
         print(f"{PROG}: refused, nothing sent: {error}", file=sys.stderr)
         return EXIT_REFUSED
+    for notice in notices:
+        print(f"{PROG}: note: {notice}", file=sys.stderr)
 
     def make_app(cfg: CommandTool) -> CommandSender:
         timeout = args.timeout if args.timeout is not None else cfg.ack_timeout
