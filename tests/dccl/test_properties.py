@@ -166,7 +166,8 @@ def element_value(draw, spec: Spec) -> Any:
     if f.type == "enum":
         return draw(st.sampled_from(f.enum))[1]
     if f.type == "string":  # not empty: DCCL sends "" as "not present"
-        return draw(st.text(alphabet="abcxyzé", min_size=1, max_size=f.options["max_length"] // 2 or 1))
+        limit = f.options["max_length"]
+        return draw(st.text(alphabet="abcxyzé", min_size=1, max_size=limit).filter(lambda t: len(t.encode()) <= limit))
     if f.type == "bytes":
         return draw(st.binary(min_size=f.options["max_length"], max_size=f.options["max_length"]))
     if f.type == "message":

@@ -173,3 +173,47 @@ class Layout(_message.Message):
     ok: bool
     ratio: float
     def __init__(self, head_a: _Optional[int] = ..., head_pair: _Optional[_Union[Layout.Pair, _Mapping]] = ..., body_inner: _Optional[_Union[Layout.Inner, _Mapping]] = ..., plain_inner: _Optional[_Union[Layout.Inner, _Mapping]] = ..., many: _Optional[_Iterable[_Union[Layout.Inner, _Mapping]]] = ..., values: _Optional[_Iterable[float]] = ..., words: _Optional[_Iterable[str]] = ..., ok: _Optional[bool] = ..., ratio: _Optional[float] = ...) -> None: ...
+
+class BenchNested(_message.Message):
+    __slots__ = ("vehicle", "time", "depth", "active", "pose", "status")
+    class Pose(_message.Message):
+        __slots__ = ("x", "y", "heading")
+        X_FIELD_NUMBER: _ClassVar[int]
+        Y_FIELD_NUMBER: _ClassVar[int]
+        HEADING_FIELD_NUMBER: _ClassVar[int]
+        x: float
+        y: float
+        heading: float
+        def __init__(self, x: _Optional[float] = ..., y: _Optional[float] = ..., heading: _Optional[float] = ...) -> None: ...
+    class Status(_message.Message):
+        __slots__ = ("mode", "battery", "note")
+        class Mode(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
+            __slots__ = ()
+            IDLE: _ClassVar[BenchNested.Status.Mode]
+            SURVEY: _ClassVar[BenchNested.Status.Mode]
+            TRANSIT: _ClassVar[BenchNested.Status.Mode]
+            RECOVER: _ClassVar[BenchNested.Status.Mode]
+        IDLE: BenchNested.Status.Mode
+        SURVEY: BenchNested.Status.Mode
+        TRANSIT: BenchNested.Status.Mode
+        RECOVER: BenchNested.Status.Mode
+        MODE_FIELD_NUMBER: _ClassVar[int]
+        BATTERY_FIELD_NUMBER: _ClassVar[int]
+        NOTE_FIELD_NUMBER: _ClassVar[int]
+        mode: BenchNested.Status.Mode
+        battery: int
+        note: str
+        def __init__(self, mode: _Optional[_Union[BenchNested.Status.Mode, str]] = ..., battery: _Optional[int] = ..., note: _Optional[str] = ...) -> None: ...
+    VEHICLE_FIELD_NUMBER: _ClassVar[int]
+    TIME_FIELD_NUMBER: _ClassVar[int]
+    DEPTH_FIELD_NUMBER: _ClassVar[int]
+    ACTIVE_FIELD_NUMBER: _ClassVar[int]
+    POSE_FIELD_NUMBER: _ClassVar[int]
+    STATUS_FIELD_NUMBER: _ClassVar[int]
+    vehicle: int
+    time: float
+    depth: float
+    active: bool
+    pose: BenchNested.Pose
+    status: BenchNested.Status
+    def __init__(self, vehicle: _Optional[int] = ..., time: _Optional[float] = ..., depth: _Optional[float] = ..., active: _Optional[bool] = ..., pose: _Optional[_Union[BenchNested.Pose, _Mapping]] = ..., status: _Optional[_Union[BenchNested.Status, _Mapping]] = ...) -> None: ...

@@ -210,6 +210,15 @@ class NumericCodec(InlineCodec):
                 good = f"{wire} - {shift}" if shift > 0 else f"{wire} + {-shift}" if shift < 0 else wire
                 if _max_code(self) >= 1 << self.size:
                     good = f"({good}) & {hex((1 << self.size) - 1)}"
+            elif self.kind == "int" and _integral_step(self):
+                # DCCL's integer quantize (remainder toward zero, up from half a step), exact below 2^52
+                step, qmin, w, rem = int(res), self._qmin(), src.tmp("w"), src.tmp("r")
+                src.line(f"{rem} = {wire} % {step} if {wire} >= 0 else -(-{wire} % {step})")
+                src.line(f"{w} = {wire} - {rem} + {step} if {rem} >= {res / 2!r} else {wire} - {rem}")
+                check = f"{lo!r} <= {w} <= {hi!r}"
+                good = f"int(({w} - {qmin}) / {step})" + (f" + {null}" if null else "")
+                if _max_code(self) >= 1 << self.size:
+                    good = f"({good}) & {hex((1 << self.size) - 1)}"
             else:
                 helper = helper or "inte"
                 fn = src.bind(f32_encode if self.kind == "float" else int_encode, helper)
@@ -245,8 +254,9 @@ class NumericCodec(InlineCodec):
         elif self.kind == "float":
             fn = src.bind(f32_decode, "f32d")
             expr = f"{fn}({code}, {self.lower()!r}, {res!r})"
-        elif res == 1 and _decoded_int_fits(self, qmin):
-            expr = f"{code} + {qmin}" if qmin else code
+        elif (res == 1 or _integral_step(self)) and _decoded_int_fits(self, qmin, int(res)):
+            scaled = code if res == 1 else f"{code} * {int(res)}"
+            expr = f"{scaled} + {qmin}" if qmin else scaled
         else:
             fn = src.bind(int_decode, "intd")
             expr = f"{fn}({code}, {self.lower()!r}, {res!r}, {self.int_bits}, {self.signed})"
@@ -281,12 +291,19 @@ def _max_code(codec: NumericCodec) -> int:
     return math.floor(span + 0.5) + codec.null
 
 
-def _decoded_int_fits(codec: NumericCodec, qmin: int) -> bool:
+def _integral_step(codec: NumericCodec) -> bool:
+    """An integer field with a whole step > 1 and bounds well inside a double's exact integers."""
+    res = codec.resolution()
+    return (res > 1 and not arith.is_fractional(res) and max(abs(codec.lower()), abs(codec.upper())) < 2.0 ** 52
+            and res < 2.0 ** 52)
+
+
+def _decoded_int_fits(codec: NumericCodec, qmin: int, step: int = 1) -> bool:
     """True when every code decodes without overflowing the field's integer type (no wrapping needed)."""
-    top = (1 << codec.size) - 1 + qmin
-    if codec.signed:
-        return -(1 << (codec.int_bits - 1)) <= qmin and top < 1 << (codec.int_bits - 1)
-    return qmin >= 0 and top < 1 << codec.int_bits
+    codes = (1 << codec.size) - 1
+    low, high = (-(1 << (codec.int_bits - 1)), (1 << (codec.int_bits - 1)) - 1) if codec.signed else (
+        0, (1 << codec.int_bits) - 1)
+    return low <= qmin and codes * step <= high and codes * step + qmin <= high and codes * step < 1 << 52
 
 
 class EnumCodec(NumericCodec):
@@ -428,8 +445,10 @@ class TimeCodec(NumericCodec):
         t = src.tmp("t")
         fmod = src.bind(arith.c_fmod, "fmod")
         # for a non-negative finite number Python's % is C's fmod; anything else takes the exact path
-        src.line(f"{t} = {seconds}")
-        src.line(f"{t} = {t} % {period!r} if {t} >= 0.0 else {fmod}({t}, {period!r})")
+        if self.as_int:
+            src.line(f"{t} = {seconds}")
+            seconds = t
+        src.line(f"{t} = {seconds} % {period!r} if {seconds} >= 0.0 else {fmod}({seconds}, {period!r})")
         return t
 
     def emit_post(self, src: Source, value: str, sink: Sink) -> None:
