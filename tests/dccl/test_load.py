@@ -101,3 +101,17 @@ def test_omit_id_messages_decode_with_their_type():
     assert data == bytes([7 + 1]) and codec.id(message_type) is None
     assert codec.decode(data, message_type) == message_type(a=7)
     assert codec.max_size(message_type) == 1
+
+
+def test_fixed_count_repeated_field_in_the_head():
+    """min_repeat == max_repeat makes a repeated field fixed-size, so DCCL allows it in the head."""
+    message_type = dccl_type([
+        FieldDef("h", "int32", "repeated", {"min": 0, "max": 7, "min_repeat": 2, "max_repeat": 2, "in_head": True}),
+        FieldDef("b", "int32", "required", {"min": 0, "max": 255}),
+    ])
+    codec = Codec()
+    codec.load(message_type)
+    msg = message_type(h=[5, 6], b=200)
+    data = codec.encode(msg)
+    assert data == bytes([10 << 1, 5 | 6 << 3, 200])  # id; count prefix 0 bits, 3 + 3 bits in the head; body
+    assert codec.decode(data) == msg

@@ -299,7 +299,7 @@ def _emit_encode(src: Source, dccl_id: int | None, id_bits: int, head: list[Fiel
             out.offset = id_bits
             src.line(f"h = {head_value}")
             _Encoder(src, out).fields("m", head)
-            head_bytes = f"h.to_bytes({arith.bits2bytes(out.offset)}, 'little')"
+            head_bytes = f"h.to_bytes({arith.bits2bytes(id_bits + sum(f.max_size for f in head))}, 'little')"
         else:
             head_bytes = src.bind(head_value.to_bytes(arith.bits2bytes(id_bits), "little"), "head")
         src.line("b = 0")

@@ -129,8 +129,8 @@ class InlineCodec(CodecBase):
     """A built-in codec: writes the Python source that encodes and decodes its field in the compiled functions.
 
     Fixed-size codecs (``variable = False``) produce one integer of ``max_size`` bits from a value and back;
-    variable-size codecs drive the bit cursor themselves (the compiler has synced it: use ``runtime=True``).
-    Unset fields never reach them: they are ``empty_size`` zero bits.
+    variable-size codecs drive the bit cursor themselves (``put``/``take``, and ``block`` around code that
+    branches on the data). Unset fields never reach them: they are ``empty_size`` zero bits.
     """
 
     variable = False

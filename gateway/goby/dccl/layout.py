@@ -88,10 +88,6 @@ class FieldLayout:
         return self.element_min
 
     @property
-    def inline(self) -> bool:
-        return isinstance(self.codec, InlineCodec)
-
-    @property
     def variable(self) -> bool:
         """Whether the compiled code moves the bit position by a run-time amount for this field."""
         if self.repeated or self.presence_bit:
