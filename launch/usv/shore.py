@@ -145,7 +145,7 @@ class ShoreOperator(SingleThreadApplication):
         while self._t0 is not None and self._plan and self._plan[0].at <= self._sim_elapsed():
             planned: ScheduledCommand = self._plan.pop(0)
             try:
-                message = check_dccl_bounds(planned.to_message(self.context.clock.now()))
+                message = check_dccl_bounds(planned.to_message(self.context.clock.now()), codec=self.context.dccl)
             except DcclBoundsError as error:
                 log.error("not sending %s: %s", planned.describe(), error)
                 continue

@@ -39,7 +39,7 @@ class USVManager(SingleThreadApplication):
         if command.HasField("time"):
             ack.command_time = command.time
         try:
-            checked = check_dccl_bounds(command)
+            checked = check_dccl_bounds(command, codec=self.context.dccl)
         except DcclBoundsError as error:
             log.error("refusing USVCommand %s: %s", text, error)
             ack.stage = USVCommandAck.REFUSED

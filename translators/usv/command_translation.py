@@ -11,6 +11,7 @@ import logging
 
 from google.protobuf import text_format
 
+from gateway.goby.dccl import Codec as DcclCodec
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from translators.base import Translator, translator_plugin
 from translators.errors import TranslatorError
@@ -26,15 +27,16 @@ class CommandRefusedError(TranslatorError, ValueError):
     """A USVCommand that must not reach the helm (out of DCCL bounds, or a polygon without its shape)."""
 
 
-def command_posts(command: USVCommand) -> list[tuple[str, str]]:
+def command_posts(command: USVCommand, codec: DcclCodec | None = None) -> list[tuple[str, str]]:
     """The MOOS (variable, value) pairs for one command, in the order they must be posted.
 
     The polygon update goes first so that the loiter behaviour already has its new shape when DEPLOY_STATE
     activates it. Unlike the course, a POLYGON without sides or radius is refused: the course would post
-    ``radius=0,pts=0``, which BHV_Loiter cannot use.
+    ``radius=0,pts=0``, which BHV_Loiter cannot use. ``codec``: the DCCL codec that checks the bounds (see
+    ``check_dccl_bounds``).
     """
     try:
-        command = check_dccl_bounds(command)
+        command = check_dccl_bounds(command, codec=codec)
     except DcclBoundsError as error:
         raise CommandRefusedError(str(error)) from error
     state = USVCommand.AutonomyState.Name(command.desired_state)
@@ -64,7 +66,7 @@ class CommandTranslation(Translator):
         if command.HasField("time"):
             ack.command_time = command.time
         try:
-            posts = command_posts(command)
+            posts = command_posts(command, self.context.dccl)
         except CommandRefusedError as error:
             log.error("refusing USVCommand %s: %s", ack.command, error)
             ack.stage = USVCommandAck.REFUSED

@@ -19,9 +19,6 @@ from translators.errors import TranslatorError
 
 log = logging.getLogger(__name__)
 
-# A cache of compiled message types (like Goby's one codec per process); strict: out-of-range values are errors.
-_CODEC = Codec(strict=True)
-
 
 class DcclBoundsError(TranslatorError, ValueError):
     """A message that DCCL could not carry as given: a field outside its bounds, or a required field unset."""
@@ -30,19 +27,22 @@ class DcclBoundsError(TranslatorError, ValueError):
 M = TypeVar("M", bound=Message)
 
 
-def check_dccl_bounds(msg: M, notices: list[str] | None = None) -> M:
+def check_dccl_bounds(msg: M, notices: list[str] | None = None, codec: Codec | None = None) -> M:
     """A copy of ``msg`` as DCCL would deliver it, or :class:`DcclBoundsError` if DCCL could not deliver it.
 
     Each value DCCL would round to its step is rounded in the copy, and a line saying so is appended to
     ``notices`` (and logged). Time stamps (``dccl.time2`` fields) keep the sender's value: DCCL sends whole
-    seconds, but on interprocess the stamp also identifies the command's acknowledgements.
+    seconds, but on interprocess the stamp also identifies the command's acknowledgements. ``codec``: an
+    application's DCCL codec (``context.dccl``), which keeps the compiled type; by default a new one is made
+    (a few milliseconds). The check is a strict encode whatever the codec's own setting.
     """
+    codec = codec if codec is not None else Codec()
     try:
-        _CODEC.load(type(msg))
-        delivered = _CODEC.decode(_CODEC.encode(msg))
+        codec.load(type(msg))
+        delivered = codec.decode(codec.encode(msg, strict=True))
     except DcclError as error:
         raise DcclBoundsError(str(error)) from None
-    bounds = {b.name: b for b in _CODEC.bounds(type(msg))}
+    bounds = {b.name: b for b in codec.bounds(type(msg))}
     for field, value in msg.ListFields():
         spec = bounds.get(field.name)
         if spec is None or field.is_repeated or field.message_type is not None:

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from gateway.errors import GatewayError
 
-class DcclError(Exception):
-    """Root of every error the DCCL codec raises."""
+
+class DcclError(GatewayError):
+    """Root of every error the DCCL codec raises (a ``GatewayError``)."""
 
 
 class DefinitionError(DcclError):
