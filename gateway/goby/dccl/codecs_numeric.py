@@ -192,7 +192,6 @@ class NumericCodec(InlineCodec):
             src.line(f"{name} = {wire}")
             wire = name
         lo, hi, res, null = self.lower(), self.upper(), self.resolution(), self.null
-        code = src.tmp("u")
         if self.kind == "double":
             w = src.tmp("w")
             src.line(f"{w} = {_quantize_source(wire, res)}")
@@ -227,6 +226,11 @@ class NumericCodec(InlineCodec):
                 src.line(f"{c} = {fn}({wire}, {lo!r}, {hi!r}, {res!r}{extra})")
                 check = f"{c} is not None"
                 good = f"({c} + {null}) & {hex((1 << self.size) - 1)}"
+        return self.emit_checked(src, value, check, good)
+
+    def emit_checked(self, src: Source, value: str, check: str, good: str) -> str:
+        """A local holding ``good`` when ``check`` holds, else zero bits (strict mode: the error)."""
+        code = src.tmp("u")
         if self.field.strict:
             with src.block(f"if not ({check})"):
                 src.line(self.out_of_range(src, value, self.bounds_text()))
@@ -340,14 +344,9 @@ class EnumCodec(NumericCodec):
             return super().emit_encode_value(src, value)
         # number -> code in one lookup; an unknown number has no entry (zero bits, or the strict error)
         table = src.bind({n: i + self.null for i, n in enumerate(self.numbers)}, "enc")
-        code = src.tmp("u")
-        if self.field.strict:
-            with src.block(f"if {value} not in {table}"):
-                src.line(self.out_of_range(src, value, self.bounds_text()))
-            src.line(f"{code} = {table}[{value}]")
-        else:
-            src.line(f"{code} = {table}.get({value}, 0)")
-        return code
+        if not self.field.strict:
+            return f"{table}.get({value}, 0)"
+        return self.emit_checked(src, value, f"{value} in {table}", f"{table}[{value}]")
 
     def emit_pre(self, src: Source, value: str) -> str:
         if not self.packed:

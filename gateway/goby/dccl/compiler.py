@@ -80,12 +80,8 @@ def truncated(name: str, have: int, need: int, what: str = "bytes") -> Truncated
     return TruncatedError(f"{name} needs {need} {what} but only {have} are there (truncated)")
 
 
-class _Encoder:
-    """Writes the encoding statements for a list of fields."""
-
-    def __init__(self, src: Source, out: BitWriter) -> None:
-        self.src = src
-        self.out = out
+class _Walker:
+    """Writes the statements for a list of fields, by kind: repeated, embedded message, or a single value."""
 
     def fields(self, obj: str, layouts: list[FieldLayout]) -> None:
         for layout in layouts:
@@ -93,12 +89,33 @@ class _Encoder:
                 self.repeated(obj, layout)
             elif layout.is_message:
                 self.message(obj, layout)
-            elif layout.context.required:
-                value = self.src.tmp("v")
-                self.src.line(f"{value} = {obj}.{layout.name}")
-                self.value(layout, value)
             else:
-                self.optional(obj, layout)
+                self.single(obj, layout)
+
+    def repeated(self, obj: str, layout: FieldLayout) -> None:
+        raise NotImplementedError
+
+    def message(self, obj: str, layout: FieldLayout) -> None:
+        raise NotImplementedError
+
+    def single(self, obj: str, layout: FieldLayout) -> None:
+        raise NotImplementedError
+
+
+class _Encoder(_Walker):
+    """Writes the encoding statements for a list of fields."""
+
+    def __init__(self, src: Source, out: BitWriter) -> None:
+        self.src = src
+        self.out = out
+
+    def single(self, obj: str, layout: FieldLayout) -> None:
+        if layout.context.required:
+            value = self.src.tmp("v")
+            self.src.line(f"{value} = {obj}.{layout.name}")
+            self.value(layout, value)
+        else:
+            self.optional(obj, layout)
 
     def value(self, layout: FieldLayout, value: str) -> None:
         """Encode a present value at the cursor."""
@@ -181,21 +198,15 @@ class _Encoder:
             out.advance(1)
 
 
-class _Decoder:
+class _Decoder(_Walker):
     """Writes the decoding statements for a list of fields."""
 
     def __init__(self, src: Source, bits: BitReader) -> None:
         self.src = src
         self.bits = bits
 
-    def fields(self, obj: str, layouts: list[FieldLayout]) -> None:
-        for layout in layouts:
-            if layout.repeated:
-                self.repeated(obj, layout)
-            elif layout.is_message:
-                self.message(obj, layout)
-            else:
-                self.value(layout, _setter(obj, layout.name))
+    def single(self, obj: str, layout: FieldLayout) -> None:
+        self.value(layout, _setter(obj, layout.name))
 
     def value(self, layout: FieldLayout, sink: Sink) -> None:
         codec, src, bits = layout.codec, self.src, self.bits
