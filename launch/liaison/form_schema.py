@@ -3,8 +3,8 @@
 The page builds its inputs from this schema (number inputs with min/max/step, enum selects, required marks,
 auto-filled DCCL time fields, sub-messages, repeated fields with a count), and ``form_values`` checks what comes
 back against the same descriptor, so the page and the server refuse the same things.  Bounds come from the
-message's own ``(dccl.field)`` options through :mod:`translators.usv.validation`, the check the command path
-itself applies.
+message's own ``(dccl.field)`` options through the DCCL codec (``gateway.goby.dccl.numeric_bounds``), whose
+strict encode is the check the command path itself applies.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ from typing import Any
 
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 
+from gateway.goby.dccl import numeric_bounds
 from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as dccl_options
-from translators.usv.validation import field_bounds
 
 MAX_DEPTH = 8  # nesting shown for (possibly recursive) sub-messages
 DEFAULT_MAX_REPEAT = 100  # elements offered for a repeated field without (dccl.field).max_repeat
@@ -65,9 +65,13 @@ def is_auto_time(field: FieldDescriptor) -> bool:
 
 
 def dccl_bounds(field: FieldDescriptor) -> tuple[float, float, float] | None:
-    """(min, max, step) that DCCL gives a numeric field, or None: the one place the liaison reads DCCL bounds."""
-    bounds = field_bounds(field)
-    return None if bounds is None else (bounds.minimum, bounds.maximum, bounds.resolution)
+    """(min, max, step) that DCCL gives a numeric field, or None: the one place the liaison reads DCCL bounds
+    (from the DCCL codec). An integer field's step is at least 1 (DCCL leaves integers alone below that)."""
+    bounds = numeric_bounds(field)
+    if bounds is None:
+        return None
+    low, high, step = bounds
+    return low, high, step if field_kind(field) in ("float", "double") else max(step, 1.0)
 
 
 def describe_bounds(low: float, high: float, step: float) -> str:

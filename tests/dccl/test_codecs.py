@@ -193,3 +193,14 @@ def test_info_has_dccls_layout(codec):
 
 def test_generated_source_is_available(codec):
     assert "def encode(m):" in codec.source(E) and "def decode(data, start, now):" in codec.source(E)
+
+
+def test_numeric_bounds_of_one_field_without_loading_its_message():
+    from gateway.goby.dccl import numeric_bounds
+
+    fields = E.DESCRIPTOR.fields_by_name
+    assert numeric_bounds(fields["i32"]) == (-1000.0, 1000.0, 100.0)
+    assert numeric_bounds(fields["d"]) == (-100.0, 100.0, 0.01)
+    assert numeric_bounds(fields["u32"]) == (10.0, 20.0, 2.0)
+    for name in ("time_us", "fixed", "packed", "text", "present"):  # other codecs, or not numeric
+        assert numeric_bounds(fields[name]) is None, name

@@ -15,6 +15,7 @@ from typing import TypeVar
 from google.protobuf.message import Message
 
 from gateway.goby.dccl import Codec, DcclError
+from gateway.goby.portal.marshalling import is_dccl
 from translators.errors import TranslatorError
 
 log = logging.getLogger(__name__)
@@ -34,8 +35,16 @@ def check_dccl_bounds(msg: M, notices: list[str] | None = None, codec: Codec | N
     ``notices`` (and logged). Time stamps (``dccl.time2`` fields) keep the sender's value: DCCL sends whole
     seconds, but on interprocess the stamp also identifies the command's acknowledgements. ``codec``: an
     application's DCCL codec (``context.dccl``), which keeps the compiled type; by default a new one is made
-    (a few milliseconds). The check is a strict encode whatever the codec's own setting.
+    (a few milliseconds). The check is a strict encode whatever the codec's own setting. A message type without
+    DCCL options is only checked for its required fields.
     """
+    if not is_dccl(type(msg)):  # no (dccl.msg) options: DCCL never carries it, only protobuf's rules apply
+        missing = msg.FindInitializationErrors()
+        if missing:
+            raise DcclBoundsError(f"{msg.DESCRIPTOR.full_name} is missing required field(s): {', '.join(missing)}")
+        copy = type(msg)()
+        copy.CopyFrom(msg)
+        return copy
     codec = codec if codec is not None else Codec()
     try:
         codec.load(type(msg))

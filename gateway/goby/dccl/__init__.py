@@ -5,7 +5,7 @@ as the C++ ``dccl::Codec`` does, compiles each into specialised encode/decode fu
 exact bytes. See docs/dccl.md.
 """
 
-from gateway.goby.dccl.bounds import FieldBounds
+from gateway.goby.dccl.bounds import FieldBounds, numeric_bounds
 from gateway.goby.dccl.codec import Codec
 from gateway.goby.dccl.compiler import CompiledMessage
 from gateway.goby.dccl.errors import (
@@ -41,4 +41,5 @@ __all__ = [
     "TrailingBytesError",
     "TruncatedError",
     "UnknownIdError",
+    "numeric_bounds",
 ]

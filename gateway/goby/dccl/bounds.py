@@ -9,7 +9,10 @@ from typing import Any
 
 from google.protobuf.descriptor import FieldDescriptor
 
-from gateway.goby.dccl.layout import FieldLayout
+from gateway.goby.dccl.codecs_numeric import NumericCodec
+from gateway.goby.dccl.field_codec import NUMERIC_TYPES, FieldContext
+from gateway.goby.dccl.layout import SUPPORTED_VERSION, FieldLayout, field_options
+from gateway.goby.dccl.registry import CodecRegistry, default_registry
 
 _TYPE_NAMES = {
     FieldDescriptor.TYPE_DOUBLE: "double", FieldDescriptor.TYPE_FLOAT: "float", FieldDescriptor.TYPE_INT64: "int64",
@@ -83,3 +86,22 @@ def field_bounds(layout: FieldLayout, part: str) -> FieldBounds:
         codec=layout.codec_name, min_bits=layout.min_size, max_bits=layout.max_size,
         fields=tuple(field_bounds(child, part) for child in layout.children), **info,
     )
+
+
+def numeric_bounds(field: FieldDescriptor, registry: CodecRegistry | None = None) -> tuple[float, float, float] | None:
+    """(min, max, step) the codec gives one numeric field on its own (no message to load: for forms), or None
+    when the field is not numeric, has another codec than the bounded numeric one (time, static, ...) or lacks
+    ``min``/``max``. The step is DCCL's resolution, which may be finer than 1 for an integer field."""
+    options = field_options(field)
+    if field.type not in NUMERIC_TYPES or not (options.HasField("min") and options.HasField("max")):
+        return None
+    name = options.codec if options.HasField("codec") else f"dccl.default{SUPPORTED_VERSION}"
+    try:
+        _, factory = (registry or default_registry()).find(field.type, name, SUPPORTED_VERSION)
+    except LookupError:
+        return None
+    if factory is not NumericCodec:
+        return None
+    codec = NumericCodec(FieldContext(descriptor=field, options=options, message=field.containing_type.full_name,
+                                      path=field.name, codec_version=SUPPORTED_VERSION, required=True, strict=False))
+    return codec.lower(), codec.upper(), codec.resolution()
