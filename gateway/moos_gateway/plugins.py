@@ -32,7 +32,8 @@ PLUGIN_POINT = ExtensionPoint(
     what="plugin",
     source=ENV_VAR,
     # Goby3's shared-library names for the plugins we re-implement (without "lib" and ".so...")
-    aliases=MappingProxyType({"goby_ivp_frontseat_moos_gateway_plugin": "frontseat"}),
+    aliases=MappingProxyType({"goby_ivp_frontseat_moos_gateway_plugin": "frontseat",
+                              "goby3_course_moos_gateway_plugin": "goby3_course"}),
 )
 
 
