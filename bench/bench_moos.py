@@ -199,7 +199,7 @@ def one_way(kind: str, port: int, n: int, subscribers: int = 1, payload: str | N
 def start_db(kind: str) -> Iterator[tuple[int, int]]:
     """Yield (port, pid) of a running DB: ``ours`` (moos-db) or ``MOOSDB`` (the C++ one)."""
     if kind == "ours":
-        proc = subprocess.Popen([sys.executable, "-m", "gateway.moos.db_main", "--moos_port=0",
+        proc = subprocess.Popen([sys.executable, "-m", "gateway.apps.moos_db", "--moos_port=0",
                                  "--moos_community=bench"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
                                 text=True, cwd=HERE)
         line = proc.stdout.readline()  # type: ignore[union-attr]

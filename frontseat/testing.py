@@ -67,7 +67,7 @@ class SimulatorProcess:
 
 def start_simulator(port: int = 0, verbosity: int = 0, timeout: float = 30.0) -> SimulatorProcess:
     """Start ``python -m frontseat.simulator.server <port>`` and wait until it listens."""
-    args = [sys.executable, "-m", "frontseat.simulator.server", str(port)] + (["-" + "v" * verbosity] if verbosity else [])
+    args = [sys.executable, "-m", "frontseat.apps.frontseat_sim", str(port)] + (["-" + "v" * verbosity] if verbosity else [])
     process = subprocess.Popen(args, stdout=subprocess.PIPE, text=True, env=dict(os.environ, PYTHONUNBUFFERED="1"))
     assert process.stdout is not None
     line = ""

@@ -13,6 +13,7 @@ import os
 import re
 import signal
 import subprocess
+import sys
 import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -318,3 +319,17 @@ class ProcessGroup:
 
     def __exit__(self, *exc: object) -> None:
         self.stop()
+
+
+def child_environment() -> dict[str, str]:
+    """Our environment, with this interpreter's bin directory first on PATH.
+
+    So a launch file finds the console scripts of the same installation (``moos-db``, ``ivp-helm``, ...)
+    and ``python`` is this interpreter, even when the virtualenv is not activated.
+    """
+    env = dict(os.environ)
+    bin_dir = os.path.dirname(sys.executable)
+    path = env.get("PATH", "").split(os.pathsep)
+    if bin_dir not in path:
+        env["PATH"] = os.pathsep.join([bin_dir, *[p for p in path if p]])
+    return env

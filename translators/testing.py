@@ -21,7 +21,7 @@ from pathlib import Path
 
 from gateway.goby.portal import ProcessContext, SimpleThread, use_context
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
-from gateway.moos_gateway.app import GobyMOOSGateway
+from gateway.moos_gateway.application import GobyMOOSGateway
 from gateway.moos_gateway.plugins import ENV_VAR, Plugin
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from translators.base import translator_plugin
@@ -88,7 +88,7 @@ class GatewayProcess:
         self.stderr_path = self.workdir / "gateway.err"
 
     def start(self) -> GatewayProcess:
-        cmd = [sys.executable, "-m", "gateway.moos_gateway.app", str(self.config_path), *self.extra_args]
+        cmd = [sys.executable, "-m", "gateway.apps.moos_gateway", str(self.config_path), *self.extra_args]
         with open(self.stdout_path, "ab") as out, open(self.stderr_path, "ab") as err:
             self.proc = subprocess.Popen(cmd, stdout=out, stderr=err, env=self.env, cwd=self.workdir)
         return self

@@ -1,4 +1,4 @@
-"""The simulator's TCP server and the ``frontseat-sim`` console script (goby_basic_frontseat_simulator).
+"""The simulator's TCP server (goby_basic_frontseat_simulator; console script ``frontseat.apps.frontseat_sim``).
 
 One thread does everything with ``selectors``: it accepts clients, splits their bytes into ``\\r\\n`` lines,
 and every ``1/(FREQ*WARP)`` real seconds feeds the lines received since the last tick to the
@@ -9,19 +9,15 @@ garbage and abrupt disconnects are logged and dropped; a client that stops readi
 
 from __future__ import annotations
 
-import argparse
 import logging
 import selectors
-import signal
 import socket
-import sys
 import threading
 import time
 from dataclasses import dataclass, field
 
 from frontseat.simulator.model import Simulation
 from frontseat.simulator.protocol import DELIMITER
-from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
 
@@ -233,45 +229,3 @@ class SimulatorServer:
         self._selector.close()
         for sock in (self._listener, self._wake_r, self._wake_w):
             sock.close()
-
-
-def main(argv: list[str] | None = None) -> int:
-    """``frontseat-sim <tcp listen port>``: run the basic frontseat simulator until SIGINT/SIGTERM."""
-    parser = argparse.ArgumentParser(
-        prog="frontseat-sim",
-        description="Basic frontseat simulator (goby_basic_frontseat_simulator): START/CTRL/NAV/CMD over TCP.",
-    )
-    parser.add_argument("port", nargs="?", help="TCP port to listen on (0: pick a free port)")
-    parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
-    add_verbosity_argument(parser)
-    args = parser.parse_args(argv)
-    configure_logging(args.verbose, "frontseat-sim")
-    if args.port is None:
-        print("usage: frontseat-sim [tcp listen port]")
-        return 1
-    try:
-        port = int(args.port)
-        if not 0 <= port <= 65535:
-            raise ValueError
-    except ValueError:
-        print(f"frontseat-sim: invalid port {args.port!r} (expected 0..65535)", file=sys.stderr)
-        return 1
-    try:
-        server = SimulatorServer(args.host, port)
-    except OSError as exc:
-        print(f"frontseat-sim: cannot listen on {args.host}:{port}: {exc}", file=sys.stderr)
-        return 1
-    done = threading.Event()
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: done.set())
-    with server:
-        print(f"frontseat-sim listening on {server.host}:{server.port}", flush=True)
-        while not done.wait(0.5):
-            if not server.running:
-                print("server failed...", file=sys.stderr)
-                return 1
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -139,7 +139,7 @@ class MoosDBProcess:
             return self
         self._starts += 1
         out_path = self.workdir / f"moosdb-{self._starts}.out"
-        cmd = [sys.executable, "-m", "gateway.moos.db_main", f"--moos_port={self.port}",
+        cmd = [sys.executable, "-m", "gateway.apps.moos_db", f"--moos_port={self.port}",
                f"--moos_community={self.community}", f"--moos_time_warp={self.warp}", "-v", *self.extra_args]
         with open(out_path, "wb") as out, open(self.log_path, "wb") as err:
             self.proc = subprocess.Popen(cmd, stdout=out, stderr=err, cwd=self.workdir)

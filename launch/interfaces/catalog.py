@@ -7,8 +7,11 @@ imports another plugin's module does not inherit its calls. A gateway plugin is 
 
 from __future__ import annotations
 
+from launch.interfaces.analyze import analyze_modules
+from launch.interfaces.interface_yaml import dumps
+
 SHIPPED_APPLICATIONS: dict[str, list[str]] = {
-    "frontseat-interface": ["frontseat.interface_app"],
+    "frontseat-interface": ["frontseat.interface"],
     "usv-manager": ["translators.apps.usv_manager"],
     "usv-command": ["translators.apps.usv_command"],
     "moos-gateway-frontseat-plugin": ["translators.frontseat.translation"],
@@ -18,3 +21,14 @@ SHIPPED_APPLICATIONS: dict[str, list[str]] = {
     "usv-mission-shore": ["launch.usv.shore"],
     "usv-mission-recorder": ["launch.usv.recorder"],
 }
+
+
+def interface_file_name(application: str) -> str:
+    """Goby's naming: ``<target>_interface.yml``."""
+    return f"{application}_interface.yml"
+
+
+def generate_text(application: str) -> str:
+    """The interface YAML of a shipped application or of a dotted module name."""
+    modules = SHIPPED_APPLICATIONS.get(application, [application])
+    return dumps(analyze_modules(application, modules))

@@ -16,10 +16,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from launch.errors import LaunchError, MissionConfigError, ProcessDiedError
-from launch.launcher import child_environment
 from launch.launchfile import parse_file
 from launch.liaison.portal_side import READY_PREFIX as LIAISON_READY
-from launch.process_group import ManagedProcess, ProcessGroup
+from launch.process_group import ManagedProcess, ProcessGroup, child_environment
 from launch.usv.record import MissionRecord, shifted
 from launch.usv.recorder import MoosRecorder, PortalRecorder, SimClock
 from launch.usv.settings import USV_DIR, UsvSettings

@@ -58,7 +58,7 @@ def test_triangle_through_the_real_frontseat_path(tmp_path: Path) -> None:
         env = broker.env()
         env["FRONTSEAT_DRIVER_LIBRARY"] = "basic_simulator"
         with PortalClient(broker.interprocess_config(), name="observer") as client, \
-                AppProcess([sys.executable, "-m", "frontseat.interface_app", str(iface_cfg), "-v"], env=env,
+                AppProcess([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(iface_cfg), "-v"], env=env,
                            log_path=tmp_path / "iface.log"), \
                 AppProcess([sys.executable, "-m", "behaviors.apps.goby_helm_example", str(helm_cfg), "-v"],
                            env=broker.env(), log_path=tmp_path / "helm.log"):

@@ -39,7 +39,7 @@ def start_interface(tmp_path: Path, broker, cfg: Path, name: str = "iface") -> A
     env = broker.env()
     env["FRONTSEAT_DRIVER_LIBRARY"] = "basic_simulator"
     return AppProcess(
-        [sys.executable, "-m", "frontseat.interface_app", str(cfg), "-vv"],
+        [sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg), "-vv"],
         env=env,
         log_path=tmp_path / f"{name}.log",
     )
@@ -214,7 +214,7 @@ def test_exit_on_error_quits_with_code_zero(tmp_path: Path) -> None:
 def test_driver_library_failures_exit_1_naming_the_library_and_cause(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from frontseat.interface_app import main
+    from frontseat.apps.frontseat_interface import main
 
     monkeypatch.delenv("FRONTSEAT_DRIVER_LIBRARY", raising=False)
     assert main([]) == 1
@@ -244,7 +244,7 @@ def test_example_config_includes_the_driver_extension_and_parses(
 ) -> None:
     from google.protobuf import text_format
 
-    from frontseat.interface_app import main
+    from frontseat.apps.frontseat_interface import main
     from frontseat.protobuf import frontseat_interface_config_pb2 as app_pb
 
     monkeypatch.setenv("FRONTSEAT_DRIVER_LIBRARY", "libgoby_frontseat_basic_simulator.so.30")
@@ -264,7 +264,7 @@ def test_a_driver_factory_that_raises_exits_1_promptly(tmp_path: Path) -> None:
         cfg.write_text("frontseat_cfg { require_helm: false }\n")  # this driver has no config extension
         env = broker.env()
         env["FRONTSEAT_DRIVER_LIBRARY"] = str(driver)
-        iface = AppProcess([sys.executable, "-m", "frontseat.interface_app", str(cfg)], env=env,
+        iface = AppProcess([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg)], env=env,
                            log_path=tmp_path / "iface.log")
         try:
             code = iface.wait(60)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from frontseat import groups
 from frontseat.driver import FrontSeatDriver
-from frontseat.interface_app import FrontSeatInterface
+from frontseat.interface import FrontSeatInterface
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_interface_config_pb2 as app_pb

@@ -34,7 +34,7 @@ def test_moos_helm_drives_the_simulator_through_the_interface(tmp_path: Path) ->
         )
         env = broker.env()
         env["FRONTSEAT_DRIVER_LIBRARY"] = "basic_simulator"
-        iface = AppProcess([sys.executable, "-m", "frontseat.interface_app", str(cfg), "-v"], env=env,
+        iface = AppProcess([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg), "-v"], env=env,
                            log_path=tmp_path / "iface.log")
         try:
             with (

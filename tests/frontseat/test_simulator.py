@@ -207,7 +207,7 @@ def test_bad_input_leaves_the_server_serving_other_clients() -> None:
 
 
 def test_frontseat_sim_process_usage_and_run() -> None:
-    from frontseat.simulator.server import main
+    from frontseat.apps.frontseat_sim import main
 
     assert main([]) == 1
     assert main(["notaport"]) == 1

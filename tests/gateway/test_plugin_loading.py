@@ -97,7 +97,7 @@ def _run_gateway(tmp_path: Path, plugins: str | None, config: str, timeout: floa
         env[ENV_VAR] = plugins
     cfg = tmp_path / "gateway.pb.cfg"
     cfg.write_text(config)
-    return subprocess.run([sys.executable, "-m", "gateway.moos_gateway.app", str(cfg), *extra_args], env=env,
+    return subprocess.run([sys.executable, "-m", "gateway.apps.moos_gateway", str(cfg), *extra_args], env=env,
                           capture_output=True, text=True, timeout=timeout, cwd=tmp_path)
 
 
@@ -143,7 +143,7 @@ def test_exception_in_load_stops_what_earlier_plugins_started(tmp_path):
 
 def test_example_config_needs_no_plugins(tmp_path):
     env = {k: v for k, v in os.environ.items() if k != ENV_VAR}
-    result = subprocess.run([sys.executable, "-m", "gateway.moos_gateway.app", "--example_config"], env=env,
+    result = subprocess.run([sys.executable, "-m", "gateway.apps.moos_gateway", "--example_config"], env=env,
                             capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     assert "moos {" in result.stdout and "poll_frequency" in result.stdout

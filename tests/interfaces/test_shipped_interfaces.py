@@ -7,8 +7,7 @@ from pathlib import Path
 import pytest
 
 from launch.interfaces.analyze import analyze_modules
-from launch.interfaces.catalog import SHIPPED_APPLICATIONS
-from launch.interfaces.cli import generate_text, interface_file_name
+from launch.interfaces.catalog import SHIPPED_APPLICATIONS, generate_text, interface_file_name
 from launch.interfaces.deployment import DEFAULT_INTERFACES_DIR, load_deployment
 from launch.interfaces.visualize import VizOptions, build_graph
 

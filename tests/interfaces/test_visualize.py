@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from launch.interfaces.cli import main as cli_main
+from launch.apps.goby_interfaces import main as cli_main
 from launch.interfaces.deployment import DeploymentError, load_deployment
 from launch.interfaces.interface_yaml import dumps
 from launch.interfaces.model import ApplicationInterface, PubSubEntry

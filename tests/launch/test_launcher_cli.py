@@ -36,7 +36,7 @@ class LauncherRun:
 
     def __init__(self, launch_file: Path, log_dir: Path, *extra: str) -> None:
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "launch.launcher", "-d", "50", "--status-period", "0.5", "-L", str(log_dir),
+            [sys.executable, "-m", "launch.apps.goby_launch", "-d", "50", "--status-period", "0.5", "-L", str(log_dir),
              *extra, str(launch_file)],
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
@@ -186,7 +186,7 @@ def test_sigkill_after_the_kill_timeout(tmp_path):
 def test_bad_launch_files_and_options_exit_non_zero_with_the_cause(tmp_path, content, flag, message):
     launch_file = tmp_path / "x.launch"
     launch_file.write_text(content)
-    args = [sys.executable, "-m", "launch.launcher", *([flag] if flag else []), str(launch_file)]
+    args = [sys.executable, "-m", "launch.apps.goby_launch", *([flag] if flag else []), str(launch_file)]
     result = subprocess.run(args, capture_output=True, text=True, timeout=60)
     assert result.returncode != 0
     assert message in result.stderr

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from launch.config import free_tcp_port
-from launch.launcher import child_environment
+from launch.process_group import child_environment
 from launch.usv.mission import LAUNCH_FILE
 from launch.usv.settings import UsvSettings
 
@@ -72,7 +72,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
                            socket_name=str(socket_dir / "goby_usv"))
     env = child_environment() | settings.to_env()
     proc = subprocess.Popen(
-        [sys.executable, "-m", "launch.launcher", "-d", "200", "--status-period", "1", "-L", str(tmp_path / "logs"),
+        [sys.executable, "-m", "launch.apps.goby_launch", "-d", "200", "--status-period", "1", "-L", str(tmp_path / "logs"),
          str(LAUNCH_FILE)],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env,
     )

@@ -348,7 +348,7 @@ def test_skew_is_learned_from_the_welcome_and_kept_by_timing_replies() -> None:
 
 def test_response_option_slows_a_client_down() -> None:
     """MOOSDB's --response: the DB asks a client (by name or pattern) to batch its writes; nothing is lost."""
-    from gateway.moos.db_main import parse_response
+    from gateway.apps.moos_db import parse_response
     from gateway.moos.testing import running_moosdb
 
     assert parse_response("x_app:20, *_inst:0") == {"x_app": 0.02, "*_inst": 0.0}

@@ -9,7 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from gateway.moos import poke, scope
+from gateway.apps import moos_poke as poke
+from gateway.apps import moos_scope as scope
+from gateway.apps.moos_tool_args import adopt_db_time_warp
 from gateway.moos.testing import MoosDBProcess, collect_mail, connected_comms, free_port, running_moosdb
 
 BIN = Path(sys.executable).parent
@@ -169,7 +171,7 @@ def test_adopt_db_time_warp_rebases_a_skew() -> None:
         try:
             assert client.wait_until_connected(10_000)
             assert abs(clock.skew) > 1e9  # measured at warp 1 against a warp-4 DB
-            assert poke.adopt_db_time_warp(client, clock) == 4.0 and clock.warp == 4.0
+            assert adopt_db_time_warp(client, clock) == 4.0 and clock.warp == 4.0
             assert abs(clock.time() - 4 * time.time()) < 5
         finally:
             client.close(True)

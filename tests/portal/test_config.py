@@ -90,15 +90,15 @@ def test_example_config_is_complete_and_parses_back(config_type: type) -> None:
 
 
 def test_goby_broker_example_config_and_debug_cfg_cli() -> None:
-    out = subprocess.run([sys.executable, "-m", "gateway.goby.portal.broker_main", "--example_config"],
+    out = subprocess.run([sys.executable, "-m", "gateway.apps.goby_broker", "--example_config"],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0
     text_format.Parse(out.stdout, GobyDaemonConfig())
-    out = subprocess.run([sys.executable, "-m", "gateway.goby.portal.broker_main", "--interprocess", 'platform: "p1"',
+    out = subprocess.run([sys.executable, "-m", "gateway.apps.goby_broker", "--interprocess", 'platform: "p1"',
                           "--app", "debug_cfg: true"], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0
     assert text_format.Parse(out.stdout, GobyDaemonConfig()).interprocess.platform == "p1"
-    out = subprocess.run([sys.executable, "-m", "gateway.goby.portal.broker_main", "--router_threads", "x"],
+    out = subprocess.run([sys.executable, "-m", "gateway.apps.goby_broker", "--router_threads", "x"],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 2
     assert "configuration error" in out.stderr and "--router_threads" in out.stderr
@@ -108,7 +108,7 @@ def test_goby_broker_reads_goby_interprocess() -> None:
     import os
 
     env = {**os.environ, "GOBY_INTERPROCESS": 'platform: "from_env" socket_name: "/tmp/x"'}
-    out = subprocess.run([sys.executable, "-m", "gateway.goby.portal.broker_main", "--app", "debug_cfg: true"],
+    out = subprocess.run([sys.executable, "-m", "gateway.apps.goby_broker", "--app", "debug_cfg: true"],
                          capture_output=True, text=True, timeout=60, env=env)
     assert out.returncode == 0, out.stderr
     cfg = text_format.Parse(out.stdout, GobyDaemonConfig())

@@ -122,7 +122,7 @@ class FailingTranslator(Translator):
 
 
 def test_failing_constructor_leaves_nothing_running(infrastructure):
-    from gateway.moos_gateway.app import PluginLoadError
+    from gateway.moos_gateway.application import PluginLoadError
 
     db, broker = infrastructure
     cfg = gateway_config(db.port, broker.interprocess_config())
@@ -248,7 +248,7 @@ class PymoosTranslator(Translator):
 
 def test_asking_for_the_real_pymoos_when_missing_is_a_clear_error(infrastructure):
     from gateway.moos.factory import pymoos_available
-    from gateway.moos_gateway.app import PluginLoadError
+    from gateway.moos_gateway.application import PluginLoadError
 
     if pymoos_available():
         pytest.skip("the real pymoos is installed here")

@@ -67,7 +67,7 @@ def moosdb(kind: str, workdir: Path, community: str = "usv") -> Iterator[int]:
 
 
 def gateway_args(moos_port: int, origin: tuple[float, float] | None = ORIGIN) -> list[str]:
-    args = [sys.executable, "-m", "gateway.moos_gateway.app", "--moos", f'server: "127.0.0.1" port: {moos_port}', "-vv"]
+    args = [sys.executable, "-m", "gateway.apps.moos_gateway", "--moos", f'server: "127.0.0.1" port: {moos_port}', "-vv"]
     if origin is not None:
         args += ["--app", f"geodesy {{ lat_origin: {origin[0]} lon_origin: {origin[1]} }}"]
     return args

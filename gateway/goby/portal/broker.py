@@ -35,6 +35,8 @@ from gateway.goby.protobuf.interprocess_zeromq_pb2 import (
 
 log = logging.getLogger(__name__)
 
+READY_PREFIX = "goby-broker ready: "  # goby-broker's stdout line when serving, then JSON endpoints
+
 
 class BrokerError(PortalError):
     """The broker cannot start (e.g. another broker already serves the platform)."""

@@ -30,7 +30,7 @@ from typing import Any
 
 from google.protobuf import text_format
 
-from gateway.goby.portal.broker_main import READY_PREFIX
+from gateway.goby.portal.broker import READY_PREFIX
 from gateway.goby.portal.context import ProcessContext, use_context
 from gateway.goby.portal.errors import PortalError
 from gateway.goby.portal.group import GroupLike
@@ -94,7 +94,7 @@ class BrokerProcess:
         cfg = self._config()
         if self.tcp and not self.manager_port:
             cfg.tcp_port = 0
-        args = [sys.executable, "-m", "gateway.goby.portal.broker_main",
+        args = [sys.executable, "-m", "gateway.apps.goby_broker",
                 "--interprocess", text_format.MessageToString(cfg, as_one_line=True), *self.extra_args]
         if self.log_path is not None:
             with open(self.log_path, "a") as log_file:  # the child keeps its own copy of the descriptor

@@ -1,13 +1,13 @@
 """``frontseat-interface`` with the basic simulator driver preselected (Goby's generated wrapper script
 ``goby_frontseat_interface_basic_simulator``): the console script ``frontseat-interface-basic-simulator``, or
-``python -m frontseat.interface_basic_simulator``. An already set ``FRONTSEAT_DRIVER_LIBRARY`` wins."""
+``python -m frontseat.apps.frontseat_interface_basic_simulator``. An already set ``FRONTSEAT_DRIVER_LIBRARY`` wins."""
 
 from __future__ import annotations
 
 import os
 import sys
 
-from frontseat.interface_app import main as interface_main
+from frontseat.apps.frontseat_interface import main as interface_main
 from frontseat.loading import ENV_VAR
 
 

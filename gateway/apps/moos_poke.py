@@ -13,11 +13,15 @@ import re
 import sys
 import time
 
+from gateway.apps.moos_tool_args import (
+    add_server_arguments,
+    adopt_db_time_warp,
+    resolve_server,
+    split_mission_file,
+)
+from gateway.moos.client import comms
+from gateway.moos.clock import MoosClock
 from util.logsetup import add_verbosity_argument, configure_logging
-
-from .client import comms
-from .clock import MAX_WARP, MoosClock
-from .tool_args import add_server_arguments, resolve_server, split_mission_file
 
 log = logging.getLogger(__name__)
 
@@ -35,26 +39,6 @@ def parse_assignment(text: str) -> tuple[str, float | str]:
     if _NUMERIC.fullmatch(value.strip()):
         return name.strip(), float(value)
     return name.strip(), value
-
-
-def adopt_db_time_warp(client: comms, clock: MoosClock) -> float:
-    """Give ``clock`` the connected DB's time warp, inferred from the DB time in its WELCOME, as uPokeDB does.
-
-    The DB stamps its WELCOME with its warped MOOS time (unix time x warp), so ``db_time / now`` is the warp,
-    rounded to 0.001. Used by moos-poke and moos-scope when neither ``--moos_time_warp`` nor the mission file
-    gives one. A skew already taken from the WELCOME (measured at the old warp) is re-based on the new warp.
-    Returns the warp now in force.
-    """
-    welcome = client.welcome
-    if welcome is None or welcome.db_time <= 0:
-        return clock.warp
-    now = time.time()
-    warp = min(MAX_WARP, max(0.001, round(welcome.db_time / now, 3)))
-    if warp != clock.warp:
-        clock.set_warp(warp)
-        if clock.skew != 0.0:  # time correction is on (remote DB or quiet): skew = DB time - our warped time
-            clock.skew = welcome.db_time - now * warp
-    return warp
 
 
 def _same(sent: float | str, msg: object) -> bool:

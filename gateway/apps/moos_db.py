@@ -14,11 +14,10 @@ import signal
 import sys
 from pathlib import Path
 
+from gateway.moos.errors import MissionFileError
+from gateway.moos.mission_file import MissionFile
+from gateway.moos.server import MoosDB
 from util.logsetup import add_verbosity_argument, configure_logging
-
-from .errors import MissionFileError
-from .mission_file import MissionFile
-from .server import MoosDB
 
 log = logging.getLogger(__name__)
 

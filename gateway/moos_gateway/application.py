@@ -1,4 +1,5 @@
-"""``moos-gateway`` (goby_moos_gateway): a Goby multi-thread application hosting the translators of its plugins.
+"""The goby_moos_gateway application (console script ``moos-gateway``, ``gateway.apps.moos_gateway``): a Goby
+multi-thread application hosting the translators of its plugins.
 
 Plugins come from ``GOBY_MOOS_GATEWAY_PLUGINS`` (see ``gateway.moos_gateway.plugins``).  They are all resolved before the
 configuration is read, so a bad entry stops the process with exit status 1 before anything runs.  The
@@ -11,17 +12,14 @@ Goby), every translator stops and closes its MOOS client, exit 0.
 from __future__ import annotations
 
 import logging
-import sys
 
-from gateway.goby.portal import MultiThreadApplication, StartError, run_application
-from gateway.moos_gateway.plugins import Plugin, plugin_entries_from_env, resolve_plugins
+from gateway.goby.portal import MultiThreadApplication, StartError
+from gateway.moos_gateway.plugins import Plugin
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
-from util.extensions import ExtensionError
 
 log = logging.getLogger(__name__)
 
 APP_NAME = "goby_moos_gateway"
-_NO_PLUGINS_NEEDED = {"-h", "--help", "-e", "--example_config"}
 
 
 class PluginLoadError(StartError):
@@ -69,24 +67,3 @@ class GobyMOOSGateway(MultiThreadApplication):
             except Exception:
                 log.exception("unload of plugin %s raised; carrying on with shutdown", plugin.entry)
         super().close()
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Console script ``moos-gateway [config.pb.cfg] [--moos 'server: "localhost" port: 9000'] [-v]``."""
-    args = list(sys.argv[1:] if argv is None else argv)
-    plugins: list[Plugin] = []
-    if not _NO_PLUGINS_NEEDED.intersection(args):
-        try:
-            plugins = resolve_plugins(plugin_entries_from_env())
-        except ExtensionError as exc:
-            print(f"{APP_NAME}: {exc}", file=sys.stderr)
-            return 1
-
-    def build(cfg: GobyMOOSGatewayConfig) -> GobyMOOSGateway:
-        return GobyMOOSGateway(cfg, plugins)
-
-    return run_application(build, GobyMOOSGatewayConfig, args, prog=APP_NAME)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

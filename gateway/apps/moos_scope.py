@@ -16,13 +16,16 @@ import sys
 import threading
 import time
 
+from gateway.apps.moos_tool_args import (
+    add_server_arguments,
+    adopt_db_time_warp,
+    resolve_server,
+    split_mission_file,
+)
+from gateway.moos.client import comms
+from gateway.moos.clock import MoosClock
+from gateway.moos.message import MoosMessage
 from util.logsetup import add_verbosity_argument, configure_logging
-
-from .client import comms
-from .clock import MoosClock
-from .message import MoosMessage
-from .poke import adopt_db_time_warp
-from .tool_args import add_server_arguments, resolve_server, split_mission_file
 
 log = logging.getLogger(__name__)
 

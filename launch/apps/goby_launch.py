@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import os
 import shlex
 import signal
 import sys
@@ -21,7 +20,7 @@ from pathlib import Path
 
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import parse_file
-from launch.process_group import ProcessGroup
+from launch.process_group import ProcessGroup, child_environment
 from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
@@ -56,20 +55,6 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--startup-check", type=float, default=1.0, help="seconds to watch after the last launch (1)")
     add_verbosity_argument(parser)
     return parser
-
-
-def child_environment() -> dict[str, str]:
-    """Our environment, with this interpreter's bin directory first on PATH.
-
-    So a launch file finds the console scripts of the same installation (``moos-db``, ``ivp-helm``, ...)
-    and ``python`` is this interpreter, even when the virtualenv is not activated.
-    """
-    env = dict(os.environ)
-    bin_dir = os.path.dirname(sys.executable)
-    path = env.get("PATH", "").split(os.pathsep)
-    if bin_dir not in path:
-        env["PATH"] = os.pathsep.join([bin_dir, *[p for p in path if p]])
-    return env
 
 
 @contextmanager

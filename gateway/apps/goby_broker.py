@@ -14,14 +14,12 @@ import signal
 import sys
 import threading
 
-from gateway.goby.portal.broker import Broker, BrokerError
+from gateway.goby.portal.broker import READY_PREFIX, Broker, BrokerError
 from gateway.goby.portal.config import load_for_run
 from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
 from util.logsetup import configure_logging
 
 log = logging.getLogger(__name__)
-
-READY_PREFIX = "goby-broker ready: "
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -14,25 +14,13 @@ import subprocess
 import sys
 from pathlib import Path
 
-from launch.interfaces.analyze import AnalysisError, analyze_modules
-from launch.interfaces.catalog import SHIPPED_APPLICATIONS
+from launch.interfaces.analyze import AnalysisError
+from launch.interfaces.catalog import SHIPPED_APPLICATIONS, generate_text, interface_file_name
 from launch.interfaces.deployment import DEFAULT_INTERFACES_DIR, DeploymentError, load_deployment
-from launch.interfaces.interface_yaml import dumps
 from launch.interfaces.visualize import VizOptions, build_graph, to_dot
 from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
-
-
-def interface_file_name(application: str) -> str:
-    """Goby's naming: ``<target>_interface.yml``."""
-    return f"{application}_interface.yml"
-
-
-def generate_text(application: str) -> str:
-    """The interface YAML of a shipped application or of a dotted module name."""
-    modules = SHIPPED_APPLICATIONS.get(application, [application])
-    return dumps(analyze_modules(application, modules))
 
 
 def _generate(args: argparse.Namespace) -> int:

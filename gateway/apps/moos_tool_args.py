@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import argparse
 import logging
+import time
 
-from .errors import MissionFileError
-from .mission_file import MissionFile
+from gateway.moos.client import comms
+from gateway.moos.clock import MAX_WARP, MoosClock
+from gateway.moos.errors import MissionFileError
+from gateway.moos.mission_file import MissionFile
 
 log = logging.getLogger(__name__)
 
@@ -44,3 +47,23 @@ def resolve_server(args: argparse.Namespace, mission_path: str | None) -> tuple[
     if args.moos_time_warp:
         warp = args.moos_time_warp
     return host, port, warp
+
+
+def adopt_db_time_warp(client: comms, clock: MoosClock) -> float:
+    """Give ``clock`` the connected DB's time warp, inferred from the DB time in its WELCOME, as uPokeDB does.
+
+    The DB stamps its WELCOME with its warped MOOS time (unix time x warp), so ``db_time / now`` is the warp,
+    rounded to 0.001. Used by moos-poke and moos-scope when neither ``--moos_time_warp`` nor the mission file
+    gives one. A skew already taken from the WELCOME (measured at the old warp) is re-based on the new warp.
+    Returns the warp now in force.
+    """
+    welcome = client.welcome
+    if welcome is None or welcome.db_time <= 0:
+        return clock.warp
+    now = time.time()
+    warp = min(MAX_WARP, max(0.001, round(welcome.db_time / now, 3)))
+    if warp != clock.warp:
+        clock.set_warp(warp)
+        if clock.skew != 0.0:  # time correction is on (remote DB or quiet): skew = DB time - our warped time
+            clock.skew = welcome.db_time - now * warp
+    return warp

@@ -1,0 +1,1 @@
+"""Applications of the frontseat tree (console scripts): the interface process and the basic simulator."""
