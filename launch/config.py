@@ -7,15 +7,22 @@ processes cannot disagree about warp, origin or ports.
 
 from __future__ import annotations
 
+import dataclasses
+import os
 import socket
 import string
 import sys
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any, TypeVar
 
 from launch.errors import MissionConfigError
 
+T = TypeVar("T")
+
 INVALID_BANNER = "=============== INVALID CONFIGURATION ================="
+# Templates both missions render (app/interprocess blocks, broker, frontseat interface, gateway).
+SHARED_TEMPLATES = Path(__file__).resolve().parent / "templates"
 
 
 def render(template: str | Path, values: Mapping[str, object]) -> str:
@@ -54,3 +61,31 @@ def free_tcp_port(host: str = "127.0.0.1") -> int:
 def text_format_string(value: str) -> str:
     """A protobuf text-format string literal."""
     return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def settings_from_env(cls: type[T], names: Mapping[str, str], environ: Mapping[str, str] | None = None) -> T:
+    """A settings dataclass from environment variables (``names``: field -> variable); unset ones keep defaults.
+
+    Each value is converted to its field's type (int, float, Path or str); a bad one raises MissionConfigError
+    naming the variable, so every launch line that reads the settings fails the same clear way.
+    """
+    environ = os.environ if environ is None else environ
+    types = {f.name: f.type for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
+    kwargs: dict[str, Any] = {}
+    for name, var in names.items():
+        raw = environ.get(var)
+        if raw is None or raw == "":
+            continue
+        kind = types[name]
+        try:
+            if kind in ("int", int):
+                kwargs[name] = int(raw)
+            elif kind in ("float", float):
+                kwargs[name] = float(raw)
+            elif kind in ("Path", Path):
+                kwargs[name] = Path(raw)
+            else:
+                kwargs[name] = raw
+        except ValueError as exc:
+            raise MissionConfigError(f"{var}={raw!r} is not a valid {kind}") from exc
+    return cls(**kwargs)

@@ -29,6 +29,7 @@ log = logging.getLogger(__name__)
 Reporter = Callable[[str], None]
 _ASSIGNMENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*=")
 POLL_PERIOD_S = 0.1
+BROKER_PROGRAMS = frozenset({"goby-broker", "gobyd"})
 
 
 def _print(line: str) -> None:
@@ -126,7 +127,9 @@ class ProcessGroup:
     # -- start-up -------------------------------------------------------------------------------
 
     def _unique_name(self, entry: LaunchEntry, env: Mapping[str, str]) -> str:
-        base = entry.name or os.path.basename(expand_vars(entry.binary, env)) or "process"
+        # name= may use the line's variables (e.g. ${GOBY_LAUNCH_PLATFORM}.helm)
+        base = expand_vars(entry.name, env) if entry.name else ""
+        base = base or os.path.basename(expand_vars(entry.binary, env)) or "process"
         if self.platform and not entry.name:
             base = f"{self.platform}.{base}"
         taken = {p.name for p in self.processes}
@@ -300,10 +303,14 @@ class ProcessGroup:
             return
         self.report("Cleaning up...")
         if self.parallel_stop:
-            for process in live:
-                process.stop_requested = True
-                self._signal(process, process.entry.kill_signal)
-            self._wait_or_kill(live)
+            # All at once, except the brokers: they go last, as goby_launch -P kills gobyd last, so the other
+            # processes can still talk to them while they shut down.
+            brokers = [p for p in live if p.entry.binary in BROKER_PROGRAMS]
+            for wave in ([p for p in live if p not in brokers], brokers):
+                for process in wave:
+                    process.stop_requested = True
+                    self._signal(process, process.entry.kill_signal)
+                self._wait_or_kill(wave)
         else:
             for process in live:
                 process.stop_requested = True

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import shlex
 import signal
 import sys
@@ -26,6 +27,11 @@ from util.logsetup import add_verbosity_argument, configure_logging
 log = logging.getLogger(__name__)
 
 PRESEED = "preseed.goby"  # sourced before each command when it sits next to the launch file, as goby_launch does
+# Exported to every child: the launch file's directory (so a launch file of launch files names its neighbours
+# wherever it is started from) and the log directory (so a nested goby-launch without -L logs beneath it).
+LAUNCH_DIR_VAR = "GOBY_LAUNCH_DIR"
+LOG_DIR_VAR = "GOBY_LAUNCH_LOG_DIR"
+PLATFORM_VAR = "GOBY_LAUNCH_PLATFORM"  # the platform name (-p), for name= directives
 _UNSUPPORTED_MODES = {
     "screen": "-s (GNU screen)",
     "nohup": "-n (nohup)",
@@ -57,6 +63,14 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def default_log_dir(platform: str, environ: dict[str, str] | os._Environ[str]) -> str:
+    """``<parent's log dir>/<platform>`` under a parent goby-launch, else ``/tmp/goby_launch_<platform>_<UTC time>``."""
+    parent = environ.get(LOG_DIR_VAR)
+    if parent:
+        return str(Path(parent) / platform)
+    return f"/tmp/goby_launch_{platform}_{time.strftime('%Y%m%dT%H%M%S', time.gmtime())}"
+
+
 @contextmanager
 def stop_on_signals(group: ProcessGroup) -> Iterator[None]:
     """SIGINT and SIGTERM set the group's stop event; the previous handlers come back afterwards."""
@@ -86,7 +100,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"goby-launch: {exc}", file=sys.stderr)
         return 1
     platform = args.platform or Path(args.launchfile).stem
-    log_dir = args.log_dir or f"/tmp/goby_launch_{platform}_{time.strftime('%Y%m%dT%H%M%S', time.gmtime())}"
+    log_dir = default_log_dir(platform, os.environ) if args.log_dir is None else args.log_dir
+    env = child_environment()
+    env[LAUNCH_DIR_VAR] = str(Path(args.launchfile).resolve().parent)
+    env[LOG_DIR_VAR] = str(Path(log_dir).resolve())
+    env[PLATFORM_VAR] = platform
     group = ProcessGroup(
         launch_file.entries,
         log_dir,
@@ -94,7 +112,7 @@ def main(argv: list[str] | None = None) -> int:
         launch_delay_s=args.delay_ms / 1000.0,
         kill_timeout_s=args.kill_s,
         startup_check_s=args.startup_check,
-        base_env=child_environment(),
+        base_env=env,
         parallel_stop=args.parallel,
     )
     preseed = Path(args.launchfile).resolve().parent / PRESEED

@@ -14,7 +14,7 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-from launch.config import fail, render, text_format_string
+from launch.config import SHARED_TEMPLATES, fail, render, text_format_string
 from launch.errors import MissionConfigError
 from launch.usv.analysis import bhv_loiter_polygon, bhv_waypoints
 from launch.usv.settings import USV_DIR, UsvSettings
@@ -39,15 +39,17 @@ def _values(settings: UsvSettings, app: str) -> dict[str, object]:
         "timeout": settings.liveness_timeout,
         "liaison_address": text_format_string(settings.liaison_address),
         "liaison_port": settings.liaison_port,
+        "vehicle_type": "USV",
     }
-    values["app_block"] = render(TEMPLATES / "_app.pb.cfg.in", values)
-    values["interprocess_block"] = render(TEMPLATES / "_interprocess.pb.cfg.in", values)
+    values["app_block"] = render(SHARED_TEMPLATES / "_app.pb.cfg.in", values)
+    values["interprocess_block"] = render(SHARED_TEMPLATES / "_interprocess.pb.cfg.in", values)
     return values
 
 
 def _pb(template: str, app: str) -> Callable[[UsvSettings], str]:
     def generate(settings: UsvSettings) -> str:
-        return render(TEMPLATES / template, _values(settings, app))
+        path = TEMPLATES / template
+        return render(path if path.is_file() else SHARED_TEMPLATES / template, _values(settings, app))
 
     return generate
 

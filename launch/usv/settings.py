@@ -9,11 +9,11 @@ simulator port 55000+id, the Kauai origin, platform ``usv``.
 from __future__ import annotations
 
 import dataclasses
-import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
+from launch.config import settings_from_env
 from launch.errors import MissionConfigError
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -104,26 +104,7 @@ class UsvSettings:
     @classmethod
     def from_env(cls, environ: Mapping[str, str] | None = None) -> UsvSettings:
         """Settings from ``USV_*`` variables; unset ones keep the defaults. Bad values raise MissionConfigError."""
-        environ = os.environ if environ is None else environ
-        kwargs: dict[str, object] = {}
-        types = {f.name: f.type for f in dataclasses.fields(cls)}
-        for field, var in _ENV.items():
-            raw = environ.get(var)
-            if raw is None or raw == "":
-                continue
-            kind = types[field]
-            try:
-                if kind in ("int", int):
-                    kwargs[field] = int(raw)
-                elif kind in ("float", float):
-                    kwargs[field] = float(raw)
-                elif kind in ("Path", Path):
-                    kwargs[field] = Path(raw)
-                else:
-                    kwargs[field] = raw
-            except ValueError as exc:
-                raise MissionConfigError(f"{var}={raw!r} is not a valid {kind}") from exc
-        return cls(**kwargs)  # type: ignore[arg-type]
+        return settings_from_env(cls, _ENV, environ)
 
     def replace(self, **changes: object) -> UsvSettings:
         return dataclasses.replace(self, **changes)  # type: ignore[arg-type]

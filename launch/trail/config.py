@@ -1,0 +1,301 @@
+"""``python -m launch.trail.config PLATFORM APP``: print one app's configuration (the course's ``<platform>.pb.cfg.py``).
+
+PLATFORM is ``topside``, ``usv`` or ``auv``; the course's ``goby3_course_n_auvs`` (usv, auv) and
+``goby3_course_auv_index`` (auv) say which vehicle, ``TRAIL_*`` variables the rest (``launch.trail.settings``).
+Goby-style apps get protobuf text format, read through bash process substitution (``app <(...)``);
+``frontseat_sim`` prints the simulator's port; ``moos`` and ``bhv`` write ``<run_dir>/<platform>.moos`` /
+``.bhv`` and print the path, because MOOS applications read their file more than once and cannot use process
+substitution (``launch.trail.moos_gen`` writes both too and removes them on exit, as the course's
+``moos_gen.sh``); ``helm_command`` prints the command line of the USV's chosen helm. The course's app names
+(``gobyd``, ``goby_frontseat_interface_basic_simulator``, ``goby3_course_usv_manager``...) are accepted too.
+An unknown app prints ``App: ... not defined``; a missing variable the course's INVALID CONFIGURATION banner.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import sys
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+from launch.config import SHARED_TEMPLATES, fail, render, text_format_string
+from launch.errors import MissionConfigError
+from launch.trail.settings import (
+    MULTICAST_ADDRESS,
+    REPO_ROOT,
+    SUBNET_MASK,
+    TRAIL_DIR,
+    TrailSettings,
+    Vehicle,
+    acomms_mac_slots,
+    auv_modem_ids,
+    satellite_mac_slots,
+    vehicle_from_env,
+)
+
+TEMPLATES = TRAIL_DIR / "templates"
+USV_BHV = REPO_ROOT / "behaviors" / "usv.bhv"
+AUV_BHV_TEMPLATE = REPO_ROOT / "behaviors" / "auv.bhv.in"
+
+# The course's app names -> ours.
+ALIASES = {
+    "goby-broker": "gobyd",
+    "broker": "gobyd",
+    "goby_frontseat_interface_basic_simulator": "frontseat_interface",
+    "goby_liaison": "liaison",
+    "goby_moos_gateway": "moos_gateway",
+    "goby3_course_usv_manager": "usv_manager",
+    "goby3_course_auv_manager": "auv_manager",
+    "goby3_course_topside_manager": "topside_manager",
+    "goby3_course_helm": "helm",
+}
+
+
+def _values(settings: TrailSettings, vehicle: Vehicle, app: str) -> dict[str, object]:
+    values: dict[str, object] = {
+        "app": app,
+        "name": vehicle.name,
+        "kind": vehicle.kind,
+        "warp": settings.warp,
+        "lat_origin": repr(settings.lat_origin),
+        "lon_origin": repr(settings.lon_origin),
+        "platform": vehicle.name,
+        "socket_name": vehicle.ipc_base(settings),
+        "moos_host": "127.0.0.1",
+        "moos_port": vehicle.moos_port(settings),
+        "sim_port": vehicle.sim_port(settings),
+        "vehicle_id": vehicle.vehicle_id,
+        "vehicle_type": vehicle.kind.upper(),
+        "timeout": max(10, 3 * settings.warp),  # as the USV mission: three real seconds at least
+        "liaison_address": text_format_string(settings.liaison_address),
+        "liaison_port": vehicle.liaison_port(settings),
+        "east_duration": settings.east_duration,
+        "south_duration": settings.south_duration,
+    }
+    values["app_block"] = render(SHARED_TEMPLATES / "_app.pb.cfg.in", values)
+    values["interprocess_block"] = render(SHARED_TEMPLATES / "_interprocess.pb.cfg.in", values)
+    return values
+
+
+def _pb(template: str, app: str) -> Callable[[TrailSettings, Vehicle], str]:
+    def generate(settings: TrailSettings, vehicle: Vehicle) -> str:
+        path = TEMPLATES / template
+        return render(path if path.is_file() else SHARED_TEMPLATES / template, _values(settings, vehicle, app))
+
+    return generate
+
+
+# -- gobyd: the intervehicle links ------------------------------------------------------------------------
+
+
+def link_block(settings: TrailSettings, vehicle: Vehicle, link: str) -> str:
+    """One ``link {}`` (goby.middleware.intervehicle.protobuf.PortalConfig.link), as _link_<link>.pb.cfg.in."""
+    if link == "satellite":
+        modem_id, port, slots = vehicle.satellite_modem_id, settings.satellite_port, satellite_mac_slots()
+    else:
+        modem_id, port, slots = vehicle.acomms_modem_id, settings.acomms_port, acomms_mac_slots(vehicle.n_auvs)
+    slot_lines = "\n".join(
+        f"      slot {{ src: {src} slot_seconds: {seconds} max_frame_bytes: {size} }}" for src, seconds, size in slots
+    )
+    return f"""  link {{  # {link}
+    modem_id: {modem_id}
+    subnet_mask: {SUBNET_MASK}  # 0xFF00
+    driver {{
+      driver_type: DRIVER_UDP_MULTICAST
+      [goby.acomms.udp_multicast.protobuf.config] {{
+        multicast_address: "{MULTICAST_ADDRESS}"
+        multicast_port: {port}
+        max_frame_size: 1400
+      }}
+    }}
+    mac {{
+      type: MAC_FIXED_DECENTRALIZED
+{slot_lines}
+    }}
+  }}"""
+
+
+def broker_hosts_intervehicle() -> bool:
+    """True once goby-broker's config (GobyDaemonConfig) has gobyd's ``intervehicle`` field."""
+    from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
+
+    return "intervehicle" in GobyDaemonConfig.DESCRIPTOR.fields_by_name
+
+
+def intervehicle_block(settings: TrailSettings, vehicle: Vehicle) -> str:
+    links = "\n".join(link_block(settings, vehicle, link) for link in vehicle.links)
+    block = f"intervehicle {{\n{links}\n}}"
+    if not broker_hosts_intervehicle():
+        # Kept visible in the generated text, so the missing piece is obvious.
+        return "# this goby-broker has no intervehicle layer yet; the links gobyd would run:\n" + "\n".join(
+            f"# {line}" for line in block.splitlines()
+        )
+    return block
+
+
+def _gobyd(settings: TrailSettings, vehicle: Vehicle) -> str:
+    values = _values(settings, vehicle, "goby-broker")
+    values["intervehicle_block"] = intervehicle_block(settings, vehicle)
+    return render(TEMPLATES / "gobyd.pb.cfg.in", values)
+
+
+# -- managers, helm, liaison ------------------------------------------------------------------------------
+
+
+def _manager(app: str, kind: str) -> Callable[[TrailSettings, Vehicle], str]:
+    def generate(settings: TrailSettings, vehicle: Vehicle) -> str:
+        if vehicle.kind != kind:
+            raise MissionConfigError(f"App: {app} is not defined for platform {vehicle.kind}")
+        values = _values(settings, vehicle, app)
+        usv = Vehicle("usv", vehicle.n_auvs)
+        if kind == "topside":
+            extra = f"usv_modem_id: {usv.satellite_modem_id}"
+        elif kind == "usv":
+            extra = "\n".join(f"auv_modem_id: {m}" for m in auv_modem_ids(vehicle.n_auvs))
+        else:
+            extra = f"usv_modem_id: {usv.acomms_modem_id}"
+        values["manager_extra"] = extra
+        return render(TEMPLATES / "manager.pb.cfg.in", values)
+
+    return generate
+
+
+def liaison_supports_intervehicle() -> bool:
+    from gateway.goby.protobuf.layer_pb2 import LAYER_INTERVEHICLE
+    from launch.liaison.settings import SUPPORTED_LAYERS
+
+    return LAYER_INTERVEHICLE in SUPPORTED_LAYERS
+
+
+def _liaison(settings: TrailSettings, vehicle: Vehicle) -> str:
+    """goby-liaison: the topside's Commander sends USVCommand on intervehicle usv_command/0, as the course's."""
+    values = _values(settings, vehicle, "goby-liaison")
+    commander = ""
+    if vehicle.kind == "topside":
+        commander = """pb_commander_config {
+  load_protobuf {
+    name: "goby3_course.dccl.USVCommand"
+    publish_to { group: "goby3_course::usv_command" group_numeric: 0 layer: LAYER_INTERVEHICLE }
+  }
+}"""
+        if not liaison_supports_intervehicle():
+            commander = "# goby-liaison cannot publish on intervehicle yet; the course's Commander entry:\n" + "\n".join(
+                f"# {line}" for line in commander.splitlines()
+            )
+    values["commander_block"] = commander
+    return render(TEMPLATES / "liaison.pb.cfg.in", values)
+
+
+def _vehicle_only(kinds: tuple[str, ...], app: str, generate: Callable[[TrailSettings, Vehicle], str]):
+    def checked(settings: TrailSettings, vehicle: Vehicle) -> str:
+        if vehicle.kind not in kinds:
+            raise MissionConfigError(f"App: {app} is not defined for platform {vehicle.kind}")
+        return generate(settings, vehicle)
+
+    return checked
+
+
+# -- MOOS files --------------------------------------------------------------------------------------------
+
+
+def bhv_text(settings: TrailSettings, vehicle: Vehicle) -> str:
+    """usv.bhv as is; auv.bhv.in with this AUV's trail angle and depth."""
+    if vehicle.kind == "usv":
+        return USV_BHV.read_text()
+    return render(AUV_BHV_TEMPLATE, {"trail_angle": f"{vehicle.trail_angle:g}",
+                                     "deploy_depth": f"{vehicle.deploy_depth:g}"})
+
+
+def moos_text(settings: TrailSettings, vehicle: Vehicle) -> str:
+    values = _values(settings, vehicle, "moos")
+    values["community"] = vehicle.community
+    values["bhv_file"] = vehicle.bhv_file(settings)
+    domains = ["course:0:359:360", "speed:0:2:41"] if vehicle.kind == "usv" else \
+        ["course:0:359:360", "speed:0:4:41", "depth:0:200:201"]
+    values["domains"] = "\n".join(f"  domain = {d}" for d in domains)
+    values["platform_type"], values["platform_color"], values["platform_length"] = (
+        ("usv", "green", 4) if vehicle.kind == "usv" else ("auv", "yellow", 2))
+    return render(TEMPLATES / "trail.moos.in", values)
+
+
+def _write_atomic(path: Path, text: str) -> Path:
+    """Several launch lines may generate the same file at once: write a temporary file and rename it."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}-", suffix=".tmp")
+    with os.fdopen(fd, "w") as out:
+        out.write(text)
+    os.replace(tmp, path)
+    return path
+
+
+def write_moos_files(settings: TrailSettings, vehicle: Vehicle) -> tuple[Path, Path]:
+    """Write ``<platform>.moos`` and ``<platform>.bhv`` into the run directory; return both paths."""
+    if vehicle.kind == "topside":
+        raise MissionConfigError("App: moos is not defined for platform topside (it runs no MOOS)")
+    bhv = _write_atomic(vehicle.bhv_file(settings), bhv_text(settings, vehicle))
+    moos = _write_atomic(vehicle.moos_file(settings), moos_text(settings, vehicle))
+    return moos, bhv
+
+
+def _helm_command(settings: TrailSettings, vehicle: Vehicle) -> str:
+    """The USV helm's command line: the MOOS helm on usv.moos (ivp), or goby-helm-example (goby)."""
+    if settings.usv_helm == "goby":
+        path = _write_atomic(settings.run_dir / f"{vehicle.name}_helm.pb.cfg", _pb("helm.pb.cfg.in",
+                                                                                     "goby-helm-example")(settings, vehicle))
+        return f"goby-helm-example {shlex.quote(str(path))}"
+    moos, _ = write_moos_files(settings, vehicle)
+    return f"{shlex.quote(settings.helm)} {shlex.quote(str(moos))}"
+
+
+GENERATORS: dict[str, Callable[[TrailSettings, Vehicle], str]] = {
+    "gobyd": _gobyd,
+    "frontseat_sim": _vehicle_only(("usv", "auv"), "frontseat_sim", lambda s, v: str(v.sim_port(s))),
+    "frontseat_interface": _vehicle_only(("usv", "auv"), "frontseat_interface",
+                                         _pb("frontseat_interface.pb.cfg.in", "frontseat-interface")),
+    "moos_gateway": _vehicle_only(("usv", "auv"), "moos_gateway", _pb("moos_gateway.pb.cfg.in", "moos-gateway")),
+    "topside_manager": _manager("topside-manager", "topside"),
+    "usv_manager": _manager("usv-manager", "usv"),
+    "auv_manager": _manager("auv-manager", "auv"),
+    "liaison": _liaison,
+    "helm": _vehicle_only(("usv",), "helm", _pb("helm.pb.cfg.in", "goby-helm-example")),
+    "helm_command": _vehicle_only(("usv",), "helm_command", _helm_command),
+    "commander": _vehicle_only(("topside",), "commander", _pb("commander.pb.cfg.in", "trail-commander")),
+    "moos": lambda s, v: str(write_moos_files(s, v)[0]),
+    "bhv": lambda s, v: str(write_moos_files(s, v)[1]),
+}
+
+
+def generate(platform: str, app: str, settings: TrailSettings, vehicle: Vehicle | None = None) -> str:
+    """One app's configuration text; MissionConfigError for an unknown app, a bad setting or a missing variable."""
+    name = ALIASES.get(app, app)
+    try:
+        generator = GENERATORS[name]
+    except KeyError:
+        raise MissionConfigError(f"App: {app} not defined (known: {', '.join(sorted(GENERATORS))})") from None
+    vehicle = vehicle or vehicle_from_env(platform)
+    try:
+        settings.run_dir.mkdir(parents=True, exist_ok=True)
+        settings.sockets.mkdir(parents=True, exist_ok=True)
+        vehicle.log_dir(settings).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise MissionConfigError(f"cannot create the run directory {settings.run_dir}: {exc.strerror or exc}") from exc
+    return generator(settings, vehicle)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    if len(args) != 2:
+        return fail(f"usage: python -m launch.trail.config PLATFORM APP   (PLATFORM topside|usv|auv; APP one of "
+                    f"{', '.join(sorted(GENERATORS))})")
+    try:
+        text = generate(args[0], args[1], TrailSettings.from_env())
+    except MissionConfigError as exc:
+        return fail(str(exc))
+    print(text, flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,248 @@
+"""The trail mission's settings and identities, in one place: every generated config reads them from here.
+
+Two kinds of input, as in the Goby3 course's ``launch/trail/config``:
+
+* the course's own environment variables, ``goby3_course_n_auvs`` (usv, auv) and ``goby3_course_auv_index``
+  (auv), which ``all.launch`` sets per nested launch; a missing one is the course's INVALID CONFIGURATION;
+* ``TRAIL_*`` variables for what the course hard-codes (run directory, warp, origin, port bases, the choice of
+  MOOSDB and helms), so a test or the demo can run a mission on free ports; unset ones keep the course's values.
+
+Identities follow the course's ``common/vehicle.py`` and ``common/comms.py``: vehicle id 0 topside, 1 usv,
+2+i auv i; MOOS port 9000+id, simulator port 55000+id, liaison port 50000+id; satellite modem id+1, acomms
+modem id+1+256 under subnet mask 0xFF00; acomms TDMA slots alternating USV (258) and each AUV (259+i).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from launch.config import settings_from_env
+from launch.errors import MissionConfigError
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+TRAIL_DIR = Path(__file__).resolve().parent
+KAUAI_ORIGIN = (21.590491, -159.534166)
+
+N_AUVS_VAR = "goby3_course_n_auvs"
+AUV_INDEX_VAR = "goby3_course_auv_index"
+PLATFORM_KINDS = ("topside", "usv", "auv")
+
+# common/comms.py
+SUBNET_MASK = 0xFF00
+SUBNET_INDEX = {"satellite": 0, "acomms": 1}
+MODEMS_IN_SUBNET = 256
+USV_VEHICLE_ID = 1
+TOPSIDE_VEHICLE_ID = 0
+SATELLITE_SLOT = (5, 64)  # slot_seconds, max_frame_bytes (post-homework2 onward)
+ACOMMS_SLOT = (10, 128)
+MULTICAST_ADDRESS = "239.142.0.2"
+
+# The topside's default plan (sim seconds after the USV is under helm command): polygon, then waypoints.
+DEFAULT_SCHEDULE = "0:polygon:6:200,400:waypoints"
+
+_ENV = {
+    "run_dir": "TRAIL_RUN_DIR",
+    "warp": "TRAIL_WARP",
+    "lat_origin": "TRAIL_LAT_ORIGIN",
+    "lon_origin": "TRAIL_LON_ORIGIN",
+    "moos_port_base": "TRAIL_MOOS_PORT_BASE",
+    "sim_port_base": "TRAIL_SIM_PORT_BASE",
+    "liaison_port_base": "TRAIL_LIAISON_PORT_BASE",
+    "satellite_port": "TRAIL_SATELLITE_PORT",
+    "acomms_port": "TRAIL_ACOMMS_PORT",
+    "moosdb": "TRAIL_MOOSDB",
+    "helm": "TRAIL_HELM",
+    "usv_helm": "TRAIL_USV_HELM",
+    "liaison_address": "TRAIL_LIAISON_ADDRESS",
+    "schedule": "TRAIL_SCHEDULE",
+    "socket_dir": "TRAIL_SOCKET_DIR",
+    "east_duration": "TRAIL_EAST_DURATION",
+    "south_duration": "TRAIL_SOUTH_DURATION",
+}
+
+
+@dataclass(frozen=True)
+class TrailSettings:
+    """What every process of every platform must agree on: warp, origin, port bases, program choices."""
+
+    run_dir: Path = Path("/tmp/goby3_course_trail")
+    warp: int = 5  # common/sim.py
+    lat_origin: float = KAUAI_ORIGIN[0]
+    lon_origin: float = KAUAI_ORIGIN[1]
+    moos_port_base: int = 9000
+    sim_port_base: int = 55000
+    liaison_port_base: int = 50000
+    satellite_port: int = 54500
+    acomms_port: int = 54501
+    moosdb: str = "moos-db"  # or MOOSDB
+    helm: str = "ivp-helm"  # or pHelmIvP (the MOOS helm of every vehicle that runs one)
+    usv_helm: str = "ivp"  # ivp: the MOOS helm with usv.bhv; goby: homework 3's goby-helm-example
+    liaison_address: str = "127.0.0.1"  # the course binds 0.0.0.0; the page has no login, so loopback unless asked
+    schedule: str = DEFAULT_SCHEDULE
+    socket_dir: Path = Path("")  # where the brokers' IPC sockets go (default: run_dir); AF_UNIX paths are short
+    east_duration: int = 500  # homework helm legs (goby3_course_helm.pb.cfg.in)
+    south_duration: int = 200
+
+    def __post_init__(self) -> None:
+        if self.warp < 1:
+            raise MissionConfigError(f"warp must be a whole number >= 1, not {self.warp}")
+        if self.usv_helm not in ("ivp", "goby"):
+            raise MissionConfigError(f"TRAIL_USV_HELM must be ivp or goby, not {self.usv_helm!r}")
+        for name in ("moos_port_base", "sim_port_base", "liaison_port_base", "satellite_port", "acomms_port"):
+            port = getattr(self, name)
+            if not 0 < port < 65536 - 256:
+                raise MissionConfigError(f"{name} {port} is not a TCP/UDP port with room for 256 vehicles")
+        if not -90 <= self.lat_origin <= 90 or not -180 <= self.lon_origin <= 180:
+            raise MissionConfigError(f"origin {self.lat_origin},{self.lon_origin} is not a latitude,longitude")
+
+    def to_env(self) -> dict[str, str]:
+        """The ``TRAIL_*`` variables that reproduce these settings in a launch line."""
+        return {var: str(getattr(self, name)) for name, var in _ENV.items()}
+
+    @classmethod
+    def from_env(cls, environ: Mapping[str, str] | None = None) -> TrailSettings:
+        return settings_from_env(cls, _ENV, environ)
+
+    def replace(self, **changes: object) -> TrailSettings:
+        return dataclasses.replace(self, **changes)  # type: ignore[arg-type]
+
+    @property
+    def sockets(self) -> Path:
+        return self.socket_dir if str(self.socket_dir) not in ("", ".") else self.run_dir
+
+
+@dataclass(frozen=True)
+class Vehicle:
+    """One platform of the mission: its kind, index, and the ids and ports derived from them."""
+
+    kind: str  # topside, usv, auv
+    n_auvs: int = 0
+    index: int = 0  # AUV index (auv only)
+
+    def __post_init__(self) -> None:
+        if self.kind not in PLATFORM_KINDS:
+            raise MissionConfigError(f"platform {self.kind!r} is not one of {', '.join(PLATFORM_KINDS)}")
+        if self.n_auvs < 0 or self.n_auvs > 250:
+            raise MissionConfigError(f"{N_AUVS_VAR}={self.n_auvs} is not between 0 and 250")
+        if self.kind == "auv" and not 0 <= self.index < self.n_auvs:
+            raise MissionConfigError(f"{AUV_INDEX_VAR}={self.index} is not below {N_AUVS_VAR}={self.n_auvs}")
+
+    @property
+    def name(self) -> str:
+        """The interprocess platform and launcher prefix: ``topside``, ``usv``, ``auv<i>``."""
+        return f"auv{self.index}" if self.kind == "auv" else self.kind
+
+    @property
+    def vehicle_id(self) -> int:
+        return {"topside": TOPSIDE_VEHICLE_ID, "usv": USV_VEHICLE_ID}.get(self.kind, self.index + 2)
+
+    @property
+    def display_name(self) -> str:
+        """What nav_convert's ``vehicle_name()`` calls it: ``USV``, ``AUV_<i>``, ``TOPSIDE``."""
+        return {"topside": "TOPSIDE", "usv": "USV"}.get(self.kind, f"AUV_{self.index}")
+
+    @property
+    def community(self) -> str:
+        """The MOOS community (the course hard-codes ``trail_usv``; AUVs are ``AUV<i>``)."""
+        return "trail_usv" if self.kind == "usv" else f"AUV{self.index}"
+
+    @property
+    def satellite_modem_id(self) -> int:
+        return satellite_modem_id(self.vehicle_id)
+
+    @property
+    def acomms_modem_id(self) -> int:
+        return acomms_modem_id(self.vehicle_id)
+
+    @property
+    def links(self) -> tuple[str, ...]:
+        """The intervehicle links its gobyd runs: topside satellite, USV both, AUV acomms."""
+        return {"topside": ("satellite",), "usv": ("satellite", "acomms")}.get(self.kind, ("acomms",))
+
+    @property
+    def trail_angle(self) -> float:
+        """auv.bhv's relative trail angle: 90 + 180/(n-1)*i; the course divides by zero for n = 1, we trail astern."""
+        if self.n_auvs < 2:
+            return 180.0
+        return 90.0 + (270.0 - 90.0) / (self.n_auvs - 1) * self.index
+
+    @property
+    def deploy_depth(self) -> float:
+        return 10.0 + 10.0 * self.index
+
+    def moos_port(self, settings: TrailSettings) -> int:
+        return settings.moos_port_base + self.vehicle_id
+
+    def sim_port(self, settings: TrailSettings) -> int:
+        return settings.sim_port_base + self.vehicle_id
+
+    def liaison_port(self, settings: TrailSettings) -> int:
+        return settings.liaison_port_base + self.vehicle_id
+
+    def ipc_base(self, settings: TrailSettings) -> str:
+        return str(settings.sockets / f"goby_{self.name}")
+
+    def moos_file(self, settings: TrailSettings) -> Path:
+        return settings.run_dir / f"{self.name}.moos"
+
+    def bhv_file(self, settings: TrailSettings) -> Path:
+        return settings.run_dir / f"{self.name}.bhv"
+
+    def log_dir(self, settings: TrailSettings) -> Path:
+        """Debug logs per platform, as the course's ``logs/topside``, ``logs/usv``, ``logs/auv/<i>``."""
+        tail = Path("auv") / str(self.index) if self.kind == "auv" else Path(self.kind)
+        return settings.run_dir / "logs" / tail
+
+
+def satellite_modem_id(vehicle_id: int) -> int:
+    return SUBNET_INDEX["satellite"] * MODEMS_IN_SUBNET + vehicle_id + 1
+
+
+def acomms_modem_id(vehicle_id: int) -> int:
+    return SUBNET_INDEX["acomms"] * MODEMS_IN_SUBNET + vehicle_id + 1
+
+
+def auv_modem_ids(n_auvs: int) -> list[int]:
+    return [acomms_modem_id(i + 2) for i in range(n_auvs)]
+
+
+def acomms_mac_slots(n_auvs: int) -> list[tuple[int, int, int]]:
+    """(src, slot_seconds, max_frame_bytes) per slot: for each AUV, a USV slot and then that AUV's slot."""
+    usv = acomms_modem_id(USV_VEHICLE_ID)
+    seconds, size = ACOMMS_SLOT
+    slots: list[tuple[int, int, int]] = []
+    for modem in auv_modem_ids(n_auvs):
+        slots += [(usv, seconds, size), (modem, seconds, size)]
+    return slots
+
+
+def satellite_mac_slots() -> list[tuple[int, int, int]]:
+    seconds, size = SATELLITE_SLOT
+    return [(satellite_modem_id(TOPSIDE_VEHICLE_ID), seconds, size), (satellite_modem_id(USV_VEHICLE_ID), seconds, size)]
+
+
+def _env_int(environ: Mapping[str, str], var: str, why: str) -> int:
+    raw = environ.get(var)
+    if raw is None or raw == "":
+        raise MissionConfigError(f"environment variable {var} must be set ({why})")
+    try:
+        return int(raw)
+    except ValueError:
+        raise MissionConfigError(f"{var}={raw!r} is not a whole number") from None
+
+
+def vehicle_from_env(kind: str, environ: Mapping[str, str] | None = None) -> Vehicle:
+    """The platform a config line is for; the course's variables are required where the course requires them."""
+    environ = os.environ if environ is None else environ
+    if kind == "topside":
+        raw = environ.get(N_AUVS_VAR, "")
+        return Vehicle("topside", int(raw) if raw.isdigit() else 0)
+    if kind not in PLATFORM_KINDS:
+        raise MissionConfigError(f"platform {kind!r} is not one of {', '.join(PLATFORM_KINDS)}")
+    n_auvs = _env_int(environ, N_AUVS_VAR, "the number of AUVs")
+    index = _env_int(environ, AUV_INDEX_VAR, "this AUV's index, 0..n-1") if kind == "auv" else 0
+    return Vehicle(kind, n_auvs, index)
