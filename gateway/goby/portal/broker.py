@@ -11,9 +11,11 @@ import logging
 import os
 import socket
 import threading
+from typing import Any
 
 import zmq
 
+from gateway.errors import GatewayError
 from gateway.goby.portal.endpoints import (
     MANAGER_REQUEST_GROUP,
     MANAGER_RESPONSE_GROUP,
@@ -78,6 +80,7 @@ class Broker:
         self._ipc_files: list[str] = []  # created by this broker, removed on stop
         self._ready = threading.Event()
         self._errors: list[BaseException] = []
+        self._intervehicle: Any = None  # the intervehicle portal, when the config has an intervehicle block
 
     @property
     def is_tcp(self) -> bool:
@@ -164,13 +167,27 @@ class Broker:
             self.stop()
             raise BrokerError("the broker's manager thread did not become ready within 10 s")
         log.info("broker ready for platform %r: %s", self.ipc.platform, self.endpoints())
+        if self.cfg.HasField("intervehicle"):
+            self._start_intervehicle()
         return self
+
+    def _start_intervehicle(self) -> None:
+        """Run the intervehicle links in this process, as gobyd does (raises ``BrokerError`` naming the link)."""
+        from gateway.goby.intervehicle.host import start_intervehicle
+
+        try:
+            self._intervehicle = start_intervehicle(self.cfg, self.manager_port)
+        except GatewayError as exc:
+            self.stop()
+            raise BrokerError(f"cannot start the intervehicle portal: {exc}") from exc
 
     def stop(self) -> None:
         """Stop both threads and close every socket; idempotent."""
         if self._stopped:
             return
         self._stopped = True
+        if self._intervehicle is not None:
+            self._intervehicle.close()
         if self._proxy_control is not None:
             self._proxy_control.send(b"TERMINATE")
         if self._manager_stop is not None:

@@ -11,13 +11,16 @@ import logging
 import math
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from gateway.goby.portal.context import ProcessContext, current_context
 from gateway.goby.portal.interprocess import InterProcessPortal
 from gateway.goby.portal.interthread import InterThreadTransporter
 from gateway.goby.portal.transports import ThreadTransports
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+
+if TYPE_CHECKING:
+    from gateway.goby.intervehicle.forwarder import InterVehicleForwarder
 
 log = logging.getLogger(__name__)
 
@@ -58,6 +61,7 @@ class SimpleThread:
         self._alive = True
         self._closed = False
         self._next_loop: float | None = None
+        self._intervehicle: Any = None
 
     # ------------------------------------------------------------------------------------ accessors
     def cfg(self) -> Any:
@@ -84,6 +88,14 @@ class SimpleThread:
     def interprocess(self) -> InterProcessPortal:
         """This thread's interprocess transporter (connects to the broker on first use)."""
         return self._transports.interprocess()
+
+    def intervehicle(self) -> InterVehicleForwarder:
+        """This thread's intervehicle transporter (through interprocess to the broker's intervehicle portal)."""
+        if self._intervehicle is None:
+            from gateway.goby.intervehicle.forwarder import InterVehicleForwarder
+
+            self._intervehicle = InterVehicleForwarder(self.interprocess(), self._context, type(self).__qualname__)
+        return self._intervehicle
 
     def interthread(self) -> InterThreadTransporter:
         """This thread's interthread transporter."""

@@ -1,0 +1,159 @@
+"""The intervehicle portal hosted by ``goby-broker`` (gobyd's role): one thread per ``link`` of its
+``intervehicle {}`` block, each a portal thread with its own interprocess sockets on the broker.
+
+Each :class:`LinkThread` subscribes to the application side's groups (``modem_data_out``,
+``modem_subscription_forward_tx``/``_rx``) and publishes what its :class:`~gateway.goby.intervehicle.link.Link`
+reports (``modem_data_in``, ``modem_ack_in``, ``modem_expire_in``, ``subscription_report``). Received
+Subscriptions go out on ``modem_subscription_forward_rx`` so every link thread sees them, as in Goby.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+
+from gateway.goby.acomms.driver import ModemDriver
+from gateway.goby.acomms.errors import AcommsError, ModemConfigError
+from gateway.goby.acomms.ether import Ether, EtherDriver
+from gateway.goby.acomms.protobuf.driver_base_pb2 import DRIVER_UDP_MULTICAST, DriverConfig
+from gateway.goby.acomms.udp_multicast import UDPMulticastDriver
+from gateway.goby.intervehicle import groups
+from gateway.goby.intervehicle.link import Link, LinkConfig, LinkOutputs
+from gateway.goby.intervehicle.protobuf.intervehicle_pb2 import PortalConfig, Subscription, SubscriptionReport
+from gateway.goby.intervehicle.protobuf.serializer_transporter_pb2 import SerializerTransporterMessage
+from gateway.goby.portal.context import ProcessContext, use_context
+from gateway.goby.portal.thread import SimpleThread
+
+log = logging.getLogger(__name__)
+
+#: Goby's driver thread loop frequency (warped).
+LINK_LOOP_HZ = 10.0
+#: Real seconds after start at which a link announces itself again (apps then resend their subscriptions).
+ANNOUNCE_AGAIN_S = (0.0, 2.0)
+
+
+def make_driver(cfg: DriverConfig, ethers: dict[str, Ether] | None = None) -> ModemDriver:
+    """The driver a link's ``driver {}`` block names: DRIVER_UDP_MULTICAST, or ``driver_name: "ether:NAME"``
+    (an in-process :class:`Ether` given by the host)."""
+    which = cfg.WhichOneof("driver")
+    if which == "driver_name" and cfg.driver_name.startswith("ether"):
+        name = cfg.driver_name.partition(":")[2] or "ether"
+        if ethers is None or name not in ethers:
+            raise ModemConfigError(f"driver_name {cfg.driver_name!r}: no in-process ether named {name!r} here "
+                                   "(ethers exist only when the portal is created in-process)")
+        return EtherDriver(ethers[name])
+    if which == "driver_type" and cfg.driver_type == DRIVER_UDP_MULTICAST:
+        return UDPMulticastDriver()
+    what = cfg.driver_name if which == "driver_name" else DriverConfig.DESCRIPTOR.fields_by_name[
+        "driver_type"].enum_type.values_by_number[cfg.driver_type].name
+    raise ModemConfigError(f"link driver {what} is not available (use DRIVER_UDP_MULTICAST or driver_name: \"ether\")")
+
+
+class LinkThread(SimpleThread):
+    """One link's loop (10 Hz warped) and its interprocess plumbing."""
+
+    def __init__(self, cfg: LinkConfig, driver: ModemDriver) -> None:
+        super().__init__(cfg, loop_frequency_hz=LINK_LOOP_HZ)
+        ip = self.interprocess()
+        outputs = LinkOutputs(
+            data_in=lambda m: ip.publish(groups.modem_data_in, m),
+            ack_in=lambda m: ip.publish(groups.modem_ack_in, m),
+            expire_in=lambda m: ip.publish(groups.modem_expire_in, m),
+            subscription_rx=lambda m: ip.publish(groups.modem_subscription_forward_rx, m),
+            subscription_report=lambda m: ip.publish(groups.subscription_report, m),
+        )
+        self.link = Link(cfg, driver, self.context.clock.now, outputs)
+        ip.subscribe(groups.modem_data_out, SerializerTransporterMessage, self.link.buffer_message)
+        ip.subscribe(groups.modem_subscription_forward_tx, Subscription, self.link.forward_subscription)
+        ip.subscribe(groups.modem_subscription_forward_rx, Subscription, self.link.accept_subscription)
+        self._announce = [time.monotonic() + s for s in ANNOUNCE_AGAIN_S]
+
+    def initialize(self) -> None:
+        self.link.start()
+
+    def loop(self) -> None:
+        if self._announce and time.monotonic() >= self._announce[0]:
+            self._announce.pop(0)
+            self.interprocess().publish(groups.subscription_report,
+                                        SubscriptionReport(link_modem_id=self.link.modem_id))
+        self.link.loop()
+
+    def finalize(self) -> None:
+        self.link.stop()
+
+
+class IntervehiclePortal:
+    """Runs the links of a ``PortalConfig`` in ``context`` (the broker's); ``start()`` returns once every link's
+    driver started (raises ``AcommsError`` naming the link otherwise); ``stop()`` is idempotent."""
+
+    def __init__(self, cfg: PortalConfig, context: ProcessContext, ethers: dict[str, Ether] | None = None,
+                 driver_factory: Callable[[DriverConfig], ModemDriver] | None = None) -> None:
+        self.cfg = cfg
+        self.context = context
+        self._factory = driver_factory or (lambda c: make_driver(c, ethers))
+        self._threads: list[tuple[LinkThread, threading.Thread]] = []
+        self._stopped = False
+
+    @property
+    def links(self) -> list[Link]:
+        return [t.link for t, _ in self._threads]
+
+    def start(self) -> IntervehiclePortal:
+        self.context.release_hold()  # the portal serves others; it never waits for required clients
+        try:
+            for link_cfg in self.cfg.link:
+                self._start_link(link_cfg)
+        except BaseException:
+            self.stop()
+            raise
+        return self
+
+    def _start_link(self, cfg: LinkConfig) -> None:
+        driver = self._factory(cfg.driver)
+        started = threading.Event()
+        box: dict[str, object] = {}
+
+        def target() -> None:
+            with use_context(self.context):
+                thread: LinkThread | None = None
+                try:
+                    thread = LinkThread(cfg, driver)
+                    thread.initialize()
+                except BaseException as exc:  # noqa: BLE001 - reported to start()
+                    if thread is not None:
+                        thread.close()
+                    box["error"] = exc
+                    started.set()
+                    return
+                box["thread"] = thread
+                started.set()
+                try:
+                    while thread.alive:
+                        thread.run_once()
+                except Exception:
+                    log.exception("link %d failed", cfg.modem_id)
+                finally:
+                    thread.finalize()
+                    thread.close()
+
+        pythread = threading.Thread(target=target, name=f"intervehicle-link-{cfg.modem_id}")
+        pythread.start()
+        started.wait()
+        if "error" in box:
+            pythread.join()
+            exc = box["error"]
+            raise AcommsError(f"intervehicle link {cfg.modem_id}: {exc}") from exc  # type: ignore[misc]
+        self._threads.append((box["thread"], pythread))  # type: ignore[arg-type]
+        log.info("intervehicle link %d up (subnet mask 0x%X, %d slot(s))", cfg.modem_id, cfg.subnet_mask,
+                 len(cfg.mac.slot))
+
+    def stop(self) -> None:
+        if self._stopped:
+            return
+        self._stopped = True
+        for thread, _ in self._threads:
+            thread.quit()
+        for _, pythread in self._threads:
+            pythread.join(10)
