@@ -1,7 +1,9 @@
 """Driver for the basic frontseat simulator (Goby's ``basic_simulator`` plugin), over its TCP line protocol.
 
 Entry point ``frontseat_driver_load(cfg)``. Config: the ``basic_simulator_config`` extension (1001) of
-``Config``; importing this module registers it, which is why driver protos are loaded per driver.
+``Config``, exactly Goby's; importing this module registers it, which is why driver protos are loaded per driver.
+Our own settings (data timeout, reconnect interval) are the project extension ``basic_simulator_tuning`` (1900),
+kept out of Goby's message so that Goby-only config files work with both drivers.
 
 Unlike Goby's driver, this one notices a lost link (the frontseat becomes NOT_CONNECTED) and, on every new
 connection, sends START again, so a restarted simulator brings the interface from FS_ERROR back to
@@ -17,6 +19,7 @@ from frontseat.driver import Clock, FrontSeatDriver
 from frontseat.errors import DriverConfigError, SimulatorLineError
 from frontseat.line_client import LineClient
 from frontseat.protobuf import basic_simulator_config_pb2 as sim_pb
+from frontseat.protobuf import basic_simulator_tuning_pb2 as tuning_pb
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_pb2 as fs_pb
 from frontseat.simulator import protocol
@@ -25,6 +28,7 @@ log = logging.getLogger(__name__)
 
 CONFIG_EXTENSION = sim_pb.basic_simulator_config
 EXTENSION_NAME = "goby.middleware.frontseat.protobuf.basic_simulator_config"
+TUNING_EXTENSION = tuning_pb.basic_simulator_tuning
 
 _CTRL_STATES = {"PAYLOAD": fs_pb.FRONTSEAT_ACCEPTING_COMMANDS, "AUV": fs_pb.FRONTSEAT_IN_CONTROL}
 
@@ -46,6 +50,8 @@ class BasicSimulatorDriver(FrontSeatDriver):
         missing = self.sim_cfg.FindInitializationErrors()
         if missing:
             raise DriverConfigError(f"[{EXTENSION_NAME}] is missing required field(s): {', '.join(missing)}")
+        self.tuning = tuning_pb.BasicSimulatorTuning()
+        self.tuning.CopyFrom(cfg.Extensions[TUNING_EXTENSION])
         self._fs_state = fs_pb.FRONTSEAT_NOT_CONNECTED
         self._providing_data = False
         self._last_data_time = -math.inf
@@ -54,7 +60,7 @@ class BasicSimulatorDriver(FrontSeatDriver):
         self._link = LineClient(
             self.sim_cfg.tcp_address,
             self.sim_cfg.tcp_port,
-            reconnect_interval=self.sim_cfg.reconnect_interval,
+            reconnect_interval=self.tuning.reconnect_interval,
             name="frontseat-basic-sim-link",
         ).start()
 
@@ -88,9 +94,9 @@ class BasicSimulatorDriver(FrontSeatDriver):
         self._check_connection()
         for line in self._link.read_lines():
             self._process_line(line.strip())
-        if self.now() > self._last_data_time + self.sim_cfg.data_timeout:
+        if self.now() > self._last_data_time + self.tuning.data_timeout:
             if self._providing_data:
-                log.warning("no NAV from the simulator for %.1f s", self.sim_cfg.data_timeout)
+                log.warning("no NAV from the simulator for %.1f s", self.tuning.data_timeout)
             self._providing_data = False
 
     # ----- internals --------------------------------------------------------------------------------------

@@ -165,7 +165,6 @@ class FrontSeatDriver(abc.ABC):
             state=self._state,
             frontseat_state=self.frontseat_state(),
             helm_state=self._helm_state,
-            frontseat_providing_data=self.frontseat_providing_data(),
         )
         if self._last_helm_error != fs_pb.ERROR_HELM_NONE:
             status.helm_error = self._last_helm_error

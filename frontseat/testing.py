@@ -176,9 +176,11 @@ def basic_simulator_frontseat_cfg(
         "  [goby.middleware.frontseat.protobuf.basic_simulator_config] {\n"
         f'    tcp_address: "{host}"\n'
         f"    tcp_port: {port}\n"
+        f"    start {{ lat: {lat} lon: {lon} duration: 0 control_freq: 10 }}\n"
+        "  }\n"
+        "  [goby_moos_py.frontseat.protobuf.basic_simulator_tuning] {\n"
         f"    data_timeout: {data_timeout}\n"
         f"    reconnect_interval: {reconnect_interval}\n"
-        f"    start {{ lat: {lat} lon: {lon} duration: 0 control_freq: 10 }}\n"
         "  }\n"
         "}\n"
     )

@@ -25,7 +25,7 @@ _sym_db = _symbol_database.Default()
 from frontseat.protobuf import frontseat_config_pb2 as frontseat_dot_protobuf_dot_frontseat__config__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n/frontseat/protobuf/basic_simulator_config.proto\x12\"goby.middleware.frontseat.protobuf\x1a)frontseat/protobuf/frontseat_config.proto\"\xf9\x03\n\x1d\x42\x61sicSimulatorFrontSeatConfig\x12\x13\n\x0btcp_address\x18\x01 \x02(\t\x12\x17\n\x08tcp_port\x18\x02 \x01(\r:\x05\x35\x34\x33\x32\x31\x12\\\n\x05start\x18\x03 \x02(\x0b\x32M.goby.middleware.frontseat.protobuf.BasicSimulatorFrontSeatConfig.StartParams\x12\x18\n\x0c\x64\x61ta_timeout\x18\x64 \x01(\x01:\x02\x31\x30\x12\x1d\n\x12reconnect_interval\x18\x65 \x01(\x01:\x01\x31\x1a\x92\x02\n\x0bStartParams\x12\x0b\n\x03lat\x18\x01 \x02(\x01\x12\x0b\n\x03lon\x18\x02 \x02(\x01\x12\x13\n\x08\x64uration\x18\x03 \x01(\x05:\x01\x30\x12\x18\n\x0c\x63ontrol_freq\x18\x04 \x01(\x05:\x02\x31\x30\x12l\n\x07vehicle\x18\x05 \x01(\x0b\x32[.goby.middleware.frontseat.protobuf.BasicSimulatorFrontSeatConfig.StartParams.VehicleConfig\x1aL\n\rVehicleConfig\x12\x12\n\x05\x61\x63\x63\x65l\x18\x01 \x01(\x01:\x03\x30.5\x12\x14\n\x08hdg_rate\x18\x02 \x01(\x01:\x02\x34\x35\x12\x11\n\x06z_rate\x18\x03 \x01(\x01:\x01\x32:\x8e\x01\n\x16\x62\x61sic_simulator_config\x12*.goby.middleware.frontseat.protobuf.Config\x18\xe9\x07 \x01(\x0b\x32\x41.goby.middleware.frontseat.protobuf.BasicSimulatorFrontSeatConfig')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n/frontseat/protobuf/basic_simulator_config.proto\x12\"goby.middleware.frontseat.protobuf\x1a)frontseat/protobuf/frontseat_config.proto\"\xc0\x03\n\x1d\x42\x61sicSimulatorFrontSeatConfig\x12\x13\n\x0btcp_address\x18\x01 \x02(\t\x12\x17\n\x08tcp_port\x18\x02 \x01(\r:\x05\x35\x34\x33\x32\x31\x12\\\n\x05start\x18\x03 \x02(\x0b\x32M.goby.middleware.frontseat.protobuf.BasicSimulatorFrontSeatConfig.StartParams\x1a\x92\x02\n\x0bStartParams\x12\x0b\n\x03lat\x18\x01 \x02(\x01\x12\x0b\n\x03lon\x18\x02 \x02(\x01\x12\x13\n\x08\x64uration\x18\x03 \x01(\x05:\x01\x30\x12\x18\n\x0c\x63ontrol_freq\x18\x04 \x01(\x05:\x02\x31\x30\x12l\n\x07vehicle\x18\x05 \x01(\x0b\x32[.goby.middleware.frontseat.protobuf.BasicSimulatorFrontSeatConfig.StartParams.VehicleConfig\x1aL\n\rVehicleConfig\x12\x12\n\x05\x61\x63\x63\x65l\x18\x01 \x01(\x01:\x03\x30.5\x12\x14\n\x08hdg_rate\x18\x02 \x01(\x01:\x02\x34\x35\x12\x11\n\x06z_rate\x18\x03 \x01(\x01:\x01\x32:\x8e\x01\n\x16\x62\x61sic_simulator_config\x12*.goby.middleware.frontseat.protobuf.Config\x18\xe9\x07 \x01(\x0b\x32\x41.goby.middleware.frontseat.protobuf.BasicSimulatorFrontSeatConfig')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
@@ -33,9 +33,9 @@ _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'frontseat.protobuf.basic_si
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
   _globals['_BASICSIMULATORFRONTSEATCONFIG']._serialized_start=131
-  _globals['_BASICSIMULATORFRONTSEATCONFIG']._serialized_end=636
-  _globals['_BASICSIMULATORFRONTSEATCONFIG_STARTPARAMS']._serialized_start=362
-  _globals['_BASICSIMULATORFRONTSEATCONFIG_STARTPARAMS']._serialized_end=636
-  _globals['_BASICSIMULATORFRONTSEATCONFIG_STARTPARAMS_VEHICLECONFIG']._serialized_start=560
-  _globals['_BASICSIMULATORFRONTSEATCONFIG_STARTPARAMS_VEHICLECONFIG']._serialized_end=636
+  _globals['_BASICSIMULATORFRONTSEATCONFIG']._serialized_end=579
+  _globals['_BASICSIMULATORFRONTSEATCONFIG_STARTPARAMS']._serialized_start=305
+  _globals['_BASICSIMULATORFRONTSEATCONFIG_STARTPARAMS']._serialized_end=579
+  _globals['_BASICSIMULATORFRONTSEATCONFIG_STARTPARAMS_VEHICLECONFIG']._serialized_start=503
+  _globals['_BASICSIMULATORFRONTSEATCONFIG_STARTPARAMS_VEHICLECONFIG']._serialized_end=579
 # @@protoc_insertion_point(module_scope)

@@ -9,7 +9,7 @@ BASIC_SIMULATOR_CONFIG_FIELD_NUMBER: _ClassVar[int]
 basic_simulator_config: _descriptor.FieldDescriptor
 
 class BasicSimulatorFrontSeatConfig(_message.Message):
-    __slots__ = ("tcp_address", "tcp_port", "start", "data_timeout", "reconnect_interval")
+    __slots__ = ("tcp_address", "tcp_port", "start")
     class StartParams(_message.Message):
         __slots__ = ("lat", "lon", "duration", "control_freq", "vehicle")
         class VehicleConfig(_message.Message):
@@ -35,11 +35,7 @@ class BasicSimulatorFrontSeatConfig(_message.Message):
     TCP_ADDRESS_FIELD_NUMBER: _ClassVar[int]
     TCP_PORT_FIELD_NUMBER: _ClassVar[int]
     START_FIELD_NUMBER: _ClassVar[int]
-    DATA_TIMEOUT_FIELD_NUMBER: _ClassVar[int]
-    RECONNECT_INTERVAL_FIELD_NUMBER: _ClassVar[int]
     tcp_address: str
     tcp_port: int
     start: BasicSimulatorFrontSeatConfig.StartParams
-    data_timeout: float
-    reconnect_interval: float
-    def __init__(self, tcp_address: _Optional[str] = ..., tcp_port: _Optional[int] = ..., start: _Optional[_Union[BasicSimulatorFrontSeatConfig.StartParams, _Mapping]] = ..., data_timeout: _Optional[float] = ..., reconnect_interval: _Optional[float] = ...) -> None: ...
+    def __init__(self, tcp_address: _Optional[str] = ..., tcp_port: _Optional[int] = ..., start: _Optional[_Union[BasicSimulatorFrontSeatConfig.StartParams, _Mapping]] = ...) -> None: ...

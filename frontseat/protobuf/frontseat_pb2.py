@@ -25,35 +25,35 @@ _sym_db = _symbol_database.Default()
 from frontseat.protobuf import frontseat_data_pb2 as frontseat_dot_protobuf_dot_frontseat__data__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\"frontseat/protobuf/frontseat.proto\x12\"goby.middleware.frontseat.protobuf\x1a\'frontseat/protobuf/frontseat_data.proto\"O\n\x0fHelmStateReport\x12<\n\x05state\x18\x01 \x02(\x0e\x32-.goby.middleware.frontseat.protobuf.HelmState\"\x96\x03\n\x0fInterfaceStatus\x12\x41\n\x05state\x18\x01 \x01(\x0e\x32\x32.goby.middleware.frontseat.protobuf.InterfaceState\x12K\n\x0f\x66rontseat_state\x18\x02 \x01(\x0e\x32\x32.goby.middleware.frontseat.protobuf.FrontSeatState\x12\x41\n\nhelm_state\x18\x03 \x01(\x0e\x32-.goby.middleware.frontseat.protobuf.HelmState\x12\x41\n\nhelm_error\x18\x04 \x01(\x0e\x32-.goby.middleware.frontseat.protobuf.HelmError\x12K\n\x0f\x66rontseat_error\x18\x05 \x01(\x0e\x32\x32.goby.middleware.frontseat.protobuf.FrontSeatError\x12 \n\x18\x66rontseat_providing_data\x18\x06 \x01(\x08\"\xb8\x01\n\x0e\x43ommandRequest\x12I\n\x0e\x64\x65sired_course\x18\x01 \x01(\x0b\x32\x31.goby.middleware.frontseat.protobuf.DesiredCourse\x12!\n\x12response_requested\x18\n \x01(\x08:\x05\x66\x61lse\x12\x12\n\nrequest_id\x18\x0b \x01(\x05\x12\x19\n\x11\x63\x61ncel_request_id\x18\x14 \x01(\x05*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"y\n\x0f\x43ommandResponse\x12\x1a\n\x12request_successful\x18\n \x01(\x08\x12\x12\n\nrequest_id\x18\x0b \x01(\x05\x12\x15\n\nerror_code\x18\x14 \x01(\x05:\x01\x30\x12\x14\n\x0c\x65rror_string\x18\x15 \x01(\t*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\xb8\x01\n\rInterfaceData\x12\x43\n\x0bnode_status\x18\x01 \x01(\x0b\x32..goby.middleware.frontseat.protobuf.NodeStatus\x12\x41\n\nctd_sample\x18\x02 \x01(\x0b\x32-.goby.middleware.frontseat.protobuf.CTDSample\x12\x14\n\x0c\x64\x63\x63l_message\x18\x03 \x01(\x0c*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\xa6\x01\n\x03Raw\x12\x0b\n\x03raw\x18\x01 \x01(\x0c\x12H\n\x04type\x18\x02 \x01(\x0e\x32/.goby.middleware.frontseat.protobuf.Raw.RawType:\tRAW_ASCII\x12\x13\n\x0b\x64\x65scription\x18\x03 \x01(\t\"(\n\x07RawType\x12\r\n\tRAW_ASCII\x10\x01\x12\x0e\n\nRAW_BINARY\x10\x02*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02*\x86\x01\n\x0eInterfaceState\x12\x15\n\x11INTERFACE_STANDBY\x10\x01\x12\x14\n\x10INTERFACE_LISTEN\x10\x02\x12\x15\n\x11INTERFACE_COMMAND\x10\x03\x12\x18\n\x14INTERFACE_HELM_ERROR\x10\x04\x12\x16\n\x12INTERFACE_FS_ERROR\x10\x05*}\n\x0e\x46rontSeatState\x12\x1b\n\x17\x46RONTSEAT_NOT_CONNECTED\x10\x00\x12\x12\n\x0e\x46RONTSEAT_IDLE\x10\x01\x12 \n\x1c\x46RONTSEAT_ACCEPTING_COMMANDS\x10\x02\x12\x18\n\x14\x46RONTSEAT_IN_CONTROL\x10\x03*@\n\tHelmState\x12\x14\n\x10HELM_NOT_RUNNING\x10\x00\x12\x0e\n\nHELM_DRIVE\x10\x01\x12\r\n\tHELM_PARK\x10\x02*S\n\tHelmError\x12\x13\n\x0f\x45RROR_HELM_NONE\x10\x00\x12\x1a\n\x16\x45RROR_HELM_NOT_RUNNING\x10\x01\x12\x15\n\x11\x45RROR_HELM_PARKED\x10\x02*\x9c\x01\n\x0e\x46rontSeatError\x12\x18\n\x14\x45RROR_FRONTSEAT_NONE\x10\x00\x12!\n\x1d\x45RROR_FRONTSEAT_NOT_CONNECTED\x10\x01\x12&\n\"ERROR_FRONTSEAT_NOT_PROVIDING_DATA\x10\x02\x12%\n!ERROR_FRONTSEAT_IGNORING_COMMANDS\x10\x03')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\"frontseat/protobuf/frontseat.proto\x12\"goby.middleware.frontseat.protobuf\x1a\'frontseat/protobuf/frontseat_data.proto\"O\n\x0fHelmStateReport\x12<\n\x05state\x18\x01 \x02(\x0e\x32-.goby.middleware.frontseat.protobuf.HelmState\"\xf4\x02\n\x0fInterfaceStatus\x12\x41\n\x05state\x18\x01 \x01(\x0e\x32\x32.goby.middleware.frontseat.protobuf.InterfaceState\x12K\n\x0f\x66rontseat_state\x18\x02 \x01(\x0e\x32\x32.goby.middleware.frontseat.protobuf.FrontSeatState\x12\x41\n\nhelm_state\x18\x03 \x01(\x0e\x32-.goby.middleware.frontseat.protobuf.HelmState\x12\x41\n\nhelm_error\x18\x04 \x01(\x0e\x32-.goby.middleware.frontseat.protobuf.HelmError\x12K\n\x0f\x66rontseat_error\x18\x05 \x01(\x0e\x32\x32.goby.middleware.frontseat.protobuf.FrontSeatError\"\xb8\x01\n\x0e\x43ommandRequest\x12I\n\x0e\x64\x65sired_course\x18\x01 \x01(\x0b\x32\x31.goby.middleware.frontseat.protobuf.DesiredCourse\x12!\n\x12response_requested\x18\n \x01(\x08:\x05\x66\x61lse\x12\x12\n\nrequest_id\x18\x0b \x01(\x05\x12\x19\n\x11\x63\x61ncel_request_id\x18\x14 \x01(\x05*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"y\n\x0f\x43ommandResponse\x12\x1a\n\x12request_successful\x18\n \x01(\x08\x12\x12\n\nrequest_id\x18\x0b \x01(\x05\x12\x15\n\nerror_code\x18\x14 \x01(\x05:\x01\x30\x12\x14\n\x0c\x65rror_string\x18\x15 \x01(\t*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\xb8\x01\n\rInterfaceData\x12\x43\n\x0bnode_status\x18\x01 \x01(\x0b\x32..goby.middleware.frontseat.protobuf.NodeStatus\x12\x41\n\nctd_sample\x18\x02 \x01(\x0b\x32-.goby.middleware.frontseat.protobuf.CTDSample\x12\x14\n\x0c\x64\x63\x63l_message\x18\x03 \x01(\x0c*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02\"\xa6\x01\n\x03Raw\x12\x0b\n\x03raw\x18\x01 \x01(\x0c\x12H\n\x04type\x18\x02 \x01(\x0e\x32/.goby.middleware.frontseat.protobuf.Raw.RawType:\tRAW_ASCII\x12\x13\n\x0b\x64\x65scription\x18\x03 \x01(\t\"(\n\x07RawType\x12\r\n\tRAW_ASCII\x10\x01\x12\x0e\n\nRAW_BINARY\x10\x02*\t\x08\xe8\x07\x10\x80\x80\x80\x80\x02*\x86\x01\n\x0eInterfaceState\x12\x15\n\x11INTERFACE_STANDBY\x10\x01\x12\x14\n\x10INTERFACE_LISTEN\x10\x02\x12\x15\n\x11INTERFACE_COMMAND\x10\x03\x12\x18\n\x14INTERFACE_HELM_ERROR\x10\x04\x12\x16\n\x12INTERFACE_FS_ERROR\x10\x05*}\n\x0e\x46rontSeatState\x12\x1b\n\x17\x46RONTSEAT_NOT_CONNECTED\x10\x00\x12\x12\n\x0e\x46RONTSEAT_IDLE\x10\x01\x12 \n\x1c\x46RONTSEAT_ACCEPTING_COMMANDS\x10\x02\x12\x18\n\x14\x46RONTSEAT_IN_CONTROL\x10\x03*@\n\tHelmState\x12\x14\n\x10HELM_NOT_RUNNING\x10\x00\x12\x0e\n\nHELM_DRIVE\x10\x01\x12\r\n\tHELM_PARK\x10\x02*S\n\tHelmError\x12\x13\n\x0f\x45RROR_HELM_NONE\x10\x00\x12\x1a\n\x16\x45RROR_HELM_NOT_RUNNING\x10\x01\x12\x15\n\x11\x45RROR_HELM_PARKED\x10\x02*\x9c\x01\n\x0e\x46rontSeatError\x12\x18\n\x14\x45RROR_FRONTSEAT_NONE\x10\x00\x12!\n\x1d\x45RROR_FRONTSEAT_NOT_CONNECTED\x10\x01\x12&\n\"ERROR_FRONTSEAT_NOT_PROVIDING_DATA\x10\x02\x12%\n!ERROR_FRONTSEAT_IGNORING_COMMANDS\x10\x03')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'frontseat.protobuf.frontseat_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_INTERFACESTATE']._serialized_start=1272
-  _globals['_INTERFACESTATE']._serialized_end=1406
-  _globals['_FRONTSEATSTATE']._serialized_start=1408
-  _globals['_FRONTSEATSTATE']._serialized_end=1533
-  _globals['_HELMSTATE']._serialized_start=1535
-  _globals['_HELMSTATE']._serialized_end=1599
-  _globals['_HELMERROR']._serialized_start=1601
-  _globals['_HELMERROR']._serialized_end=1684
-  _globals['_FRONTSEATERROR']._serialized_start=1687
-  _globals['_FRONTSEATERROR']._serialized_end=1843
+  _globals['_INTERFACESTATE']._serialized_start=1238
+  _globals['_INTERFACESTATE']._serialized_end=1372
+  _globals['_FRONTSEATSTATE']._serialized_start=1374
+  _globals['_FRONTSEATSTATE']._serialized_end=1499
+  _globals['_HELMSTATE']._serialized_start=1501
+  _globals['_HELMSTATE']._serialized_end=1565
+  _globals['_HELMERROR']._serialized_start=1567
+  _globals['_HELMERROR']._serialized_end=1650
+  _globals['_FRONTSEATERROR']._serialized_start=1653
+  _globals['_FRONTSEATERROR']._serialized_end=1809
   _globals['_HELMSTATEREPORT']._serialized_start=115
   _globals['_HELMSTATEREPORT']._serialized_end=194
   _globals['_INTERFACESTATUS']._serialized_start=197
-  _globals['_INTERFACESTATUS']._serialized_end=603
-  _globals['_COMMANDREQUEST']._serialized_start=606
-  _globals['_COMMANDREQUEST']._serialized_end=790
-  _globals['_COMMANDRESPONSE']._serialized_start=792
-  _globals['_COMMANDRESPONSE']._serialized_end=913
-  _globals['_INTERFACEDATA']._serialized_start=916
-  _globals['_INTERFACEDATA']._serialized_end=1100
-  _globals['_RAW']._serialized_start=1103
-  _globals['_RAW']._serialized_end=1269
-  _globals['_RAW_RAWTYPE']._serialized_start=1218
-  _globals['_RAW_RAWTYPE']._serialized_end=1258
+  _globals['_INTERFACESTATUS']._serialized_end=569
+  _globals['_COMMANDREQUEST']._serialized_start=572
+  _globals['_COMMANDREQUEST']._serialized_end=756
+  _globals['_COMMANDRESPONSE']._serialized_start=758
+  _globals['_COMMANDRESPONSE']._serialized_end=879
+  _globals['_INTERFACEDATA']._serialized_start=882
+  _globals['_INTERFACEDATA']._serialized_end=1066
+  _globals['_RAW']._serialized_start=1069
+  _globals['_RAW']._serialized_end=1235
+  _globals['_RAW_RAWTYPE']._serialized_start=1184
+  _globals['_RAW_RAWTYPE']._serialized_end=1224
 # @@protoc_insertion_point(module_scope)

@@ -68,20 +68,18 @@ class HelmStateReport(_message.Message):
     def __init__(self, state: _Optional[_Union[HelmState, str]] = ...) -> None: ...
 
 class InterfaceStatus(_message.Message):
-    __slots__ = ("state", "frontseat_state", "helm_state", "helm_error", "frontseat_error", "frontseat_providing_data")
+    __slots__ = ("state", "frontseat_state", "helm_state", "helm_error", "frontseat_error")
     STATE_FIELD_NUMBER: _ClassVar[int]
     FRONTSEAT_STATE_FIELD_NUMBER: _ClassVar[int]
     HELM_STATE_FIELD_NUMBER: _ClassVar[int]
     HELM_ERROR_FIELD_NUMBER: _ClassVar[int]
     FRONTSEAT_ERROR_FIELD_NUMBER: _ClassVar[int]
-    FRONTSEAT_PROVIDING_DATA_FIELD_NUMBER: _ClassVar[int]
     state: InterfaceState
     frontseat_state: FrontSeatState
     helm_state: HelmState
     helm_error: HelmError
     frontseat_error: FrontSeatError
-    frontseat_providing_data: bool
-    def __init__(self, state: _Optional[_Union[InterfaceState, str]] = ..., frontseat_state: _Optional[_Union[FrontSeatState, str]] = ..., helm_state: _Optional[_Union[HelmState, str]] = ..., helm_error: _Optional[_Union[HelmError, str]] = ..., frontseat_error: _Optional[_Union[FrontSeatError, str]] = ..., frontseat_providing_data: _Optional[bool] = ...) -> None: ...
+    def __init__(self, state: _Optional[_Union[InterfaceState, str]] = ..., frontseat_state: _Optional[_Union[FrontSeatState, str]] = ..., helm_state: _Optional[_Union[HelmState, str]] = ..., helm_error: _Optional[_Union[HelmError, str]] = ..., frontseat_error: _Optional[_Union[FrontSeatError, str]] = ...) -> None: ...
 
 class CommandRequest(_message.Message):
     __slots__ = ("desired_course", "response_requested", "request_id", "cancel_request_id")

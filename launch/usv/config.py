@@ -91,6 +91,9 @@ GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
     "broker": _pb("broker.pb.cfg.in", "goby-broker"),
     "frontseat_sim": lambda s: str(s.sim_port),
     "frontseat_interface": _pb("frontseat_interface.pb.cfg.in", "frontseat-interface"),
+    # our driver's own settings, given on frontseat-interface's command line (--frontseat_cfg), so that the
+    # config file holds Goby3's fields only and the real goby_frontseat_interface accepts it
+    "frontseat_tuning": _pb("frontseat_tuning.pb.cfg.in", "frontseat-interface"),
     "moos_gateway": _pb("moos_gateway.pb.cfg.in", "moos-gateway"),
     "usv_manager": _pb("usv_manager.pb.cfg.in", "usv-manager"),
     "shore": _pb("shore.pb.cfg.in", "usv-shore"),

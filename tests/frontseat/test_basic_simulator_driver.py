@@ -11,6 +11,7 @@ import pytest
 from frontseat.basic_simulator_driver import BasicSimulatorDriver, frontseat_driver_load
 from frontseat.errors import DriverConfigError
 from frontseat.protobuf import basic_simulator_config_pb2 as sim_pb
+from frontseat.protobuf import basic_simulator_tuning_pb2 as tuning_pb
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.simulator.server import SimulatorServer
@@ -30,15 +31,16 @@ class AdjustableClock:
         return time.time() + self.offset
 
 
-def make_cfg(port: int, warp: int = 10, **sim_fields: float) -> config_pb.Config:
+def make_cfg(port: int, warp: int = 10, **tuning_fields: float) -> config_pb.Config:
     cfg = config_pb.Config(name="usv", type=20, sim_warp_factor=warp)
     cfg.origin.lat, cfg.origin.lon = ORIGIN
     ext = cfg.Extensions[sim_pb.basic_simulator_config]
     ext.tcp_address, ext.tcp_port = "127.0.0.1", port
     ext.start.lat, ext.start.lon = 41.592344, -70.71126
-    ext.reconnect_interval = 0.1
-    for name, value in sim_fields.items():
-        setattr(ext, name, value)
+    tuning = cfg.Extensions[tuning_pb.basic_simulator_tuning]
+    tuning.reconnect_interval = 0.1
+    for name, value in tuning_fields.items():
+        setattr(tuning, name, value)
     return cfg
 
 

@@ -145,7 +145,6 @@ def test_gating_status_period_publications_datum_and_helm_expiry(tmp_path: Path)
             ScriptedDriverDouble.clock.t += STATUS_PERIOD
             assert client.poll_until(lambda: len(status) == seen + 1)
             assert status[-1].state == fs.INTERFACE_COMMAND and status[-1].helm_state == fs.HELM_DRIVE
-            assert status[-1].frontseat_providing_data
 
             # driver signals: data_from_frontseat then node_status; raw_in; command_response
             driver.emit_nav = True

@@ -9,7 +9,9 @@ import pytest
 from google.protobuf import text_format
 
 import frontseat.protobuf.basic_simulator_config_pb2 as basic_sim_pb
+import frontseat.protobuf.basic_simulator_tuning_pb2 as tuning_pb
 import frontseat.protobuf.moos_helm_frontseat_interface_config_pb2 as moos_helm_pb
+from frontseat.protobuf.frontseat_config_pb2 import Config
 from frontseat.protobuf.frontseat_interface_config_pb2 import FrontSeatInterfaceConfig
 from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
 from gateway.moos.mission_file import MissionFile
@@ -58,7 +60,9 @@ def test_frontseat_and_gateway_point_at_the_same_moosdb_and_simulator(settings):
     assert (sim.start.lat, sim.start.lon) == (41.5, -70.7)
     # the course's 10 s, stretched to three real seconds at this warp
     assert fs.frontseat_cfg.helm_running_timeout == fs.frontseat_cfg.frontseat_connected_timeout == 51
-    assert sim.data_timeout == 51
+    # our driver's data timeout travels on the command line (the file holds Goby3's fields only)
+    tuning = text_format.Parse(generate("frontseat_tuning", settings), Config())
+    assert tuning.Extensions[tuning_pb.basic_simulator_tuning].data_timeout == 51
 
 
 def test_moos_file_matches_the_goby_side(settings):

@@ -24,12 +24,12 @@ def _write(tmp_path: Path, text: str) -> str:
 
 
 def test_file_then_command_line_overrides(tmp_path: Path) -> None:
-    path = _write(tmp_path, 'app { name: "from_file" loop_frequency: 2 } interprocess { platform: "file" } count: 3')
+    path = _write(tmp_path, 'app { name: "from_file" debug_cfg: false } interprocess { platform: "file" } count: 3')
     loaded = load_config(SampleAppConfig, [path, "--interprocess", 'platform: "cli"', "--count", "7",
                                          "--group", "a", "--group", "b;2", "-vv"], environ={})
     cfg = loaded.cfg
     assert cfg.app.name == "from_file"
-    assert cfg.app.loop_frequency == 2
+    assert cfg.app.HasField("debug_cfg") and not cfg.app.debug_cfg
     assert cfg.interprocess.platform == "cli"
     assert cfg.count == 7
     assert list(cfg.group) == ["a", "b;2"]
@@ -79,7 +79,7 @@ def test_example_config_is_complete_and_parses_back(config_type: type) -> None:
     for field in config_type.DESCRIPTOR.fields:
         assert field.name in text
     assert "# (optional)" in text or "(optional)" in text
-    assert parsed.app.HasField("name") is False and parsed.app.HasField("loop_frequency") is False
+    assert parsed.app.HasField("name") is False and parsed.app.HasField("binary") is False
     assert not parsed.app.HasField("geodesy")  # a block with required fields stays commented
     if config_type is SampleAppConfig:
         assert list(parsed.group) == [] and "# group: " in text

@@ -150,16 +150,6 @@ def test_loop_frequency_is_multiplied_by_warp() -> None:
     assert 15 < rate <= 55  # 50 Hz warped; 10 Hz unwarped would be at most ~11
 
 
-def test_app_loop_frequency_config_overrides_code(broker: BrokerProcess) -> None:
-    cfg = SampleAppConfig()
-    cfg.app.loop_frequency = 2
-    cfg.interprocess.CopyFrom(broker.interprocess_config())
-    with running_app(Ticker, cfg) as app:
-        assert app.loop_frequency_hz == 2
-    with running_app(Ticker, no_interprocess_cfg()) as app:
-        assert app.loop_frequency_hz == 10
-
-
 class PortalThread(SimpleThread):
     """Subscribes interprocess from a launched (non-main) thread."""
 

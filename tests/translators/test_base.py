@@ -229,12 +229,13 @@ def test_notify_protobuf_uses_the_configured_technique():
     comms = ScriptedComms([])
     iface = MOOSInterface(comms, call_soon=lambda fn: fn(), moos_time=lambda: 0.0, goby_time=lambda: 0.0,
                           technique=Technique.PREFIXED_PROTOBUF_TEXT_FORMAT)
-    iface.notify_protobuf("APP", AppConfig(name="x", loop_frequency=10))
-    assert comms.notified == [("APP", '@PB[goby.middleware.protobuf.AppConfig] name: "x" loop_frequency: 10 ')]
+    iface.notify_protobuf("APP", AppConfig(name="x", simulation={"time": {"warp_factor": 10}}))
+    assert comms.notified == [("APP", '@PB[goby.middleware.protobuf.AppConfig] name: "x" simulation { time { '
+                                      'warp_factor: 10 } } ')]
     iface.notify_protobuf("BIN", AppConfig(name="x"), Technique.PROTOBUF_NATIVE_ENCODED)
     assert comms.notified[-1] == ("binary", "BIN", AppConfig(name="x").SerializeToString())
     parsed = iface.parse_protobuf(_msg("APP", comms.notified[0][1]), AppConfig())
-    assert parsed == AppConfig(name="x", loop_frequency=10)
+    assert parsed == AppConfig(name="x", simulation={"time": {"warp_factor": 10}})
     from translators.techniques import TechniqueError
 
     with pytest.raises(TechniqueError, match="Non-PROTOBUF"):

@@ -18,9 +18,6 @@ class _Application(SimpleThread):
     """Common base: return code, ``quit(code)``, eager portal (so the main thread runs the hold handshake)."""
 
     def __init__(self, cfg: Any, loop_frequency_hz: float = 0.0) -> None:
-        descriptor = getattr(cfg, "DESCRIPTOR", None)
-        if descriptor is not None and "app" in descriptor.fields_by_name and cfg.app.HasField("loop_frequency"):
-            loop_frequency_hz = cfg.app.loop_frequency  # app.loop_frequency overrides the compiled-in value
         super().__init__(cfg, loop_frequency_hz)
         self._return_code = 0
         if interprocess_config_of(cfg) is not None:

@@ -25,7 +25,7 @@ _sym_db = _symbol_database.Default()
 from gateway.goby.protobuf import debug_logger_pb2 as gateway_dot_goby_dot_protobuf_dot_debug__logger__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n&gateway/goby/protobuf/app_config.proto\x12\x18goby.middleware.protobuf\x1a(gateway/goby/protobuf/debug_logger.proto\"\xe9\x06\n\tAppConfig\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x0e\n\x06\x62inary\x18\x02 \x01(\t\x12\x16\n\x0eloop_frequency\x18\x03 \x01(\x01\x12\x33\n\x0bglog_config\x18\n \x01(\x0b\x32\x1e.goby.util.protobuf.GLogConfig\x12I\n\nsimulation\x18\x14 \x01(\x0b\x32\x35.goby.middleware.protobuf.AppConfig.SimulatorSettings\x12<\n\x07geodesy\x18\x1e \x01(\x0b\x32+.goby.middleware.protobuf.AppConfig.Geodesy\x12>\n\nhealth_cfg\x18( \x01(\x0b\x32*.goby.middleware.protobuf.AppConfig.Health\x12:\n\x08tool_cfg\x18\x32 \x01(\x0b\x32(.goby.middleware.protobuf.AppConfig.Tool\x12\x1b\n\x13load_shared_library\x18< \x03(\t\x12\x18\n\tdebug_cfg\x18\x64 \x01(\x08:\x05\x66\x61lse\x12K\n\x10intervehicle_cfg\x18\x96\x01 \x01(\x0b\x32\x30.goby.middleware.protobuf.AppConfig.Intervehicle\x1a\xb7\x01\n\x11SimulatorSettings\x12H\n\x04time\x18\x01 \x01(\x0b\x32:.goby.middleware.protobuf.AppConfig.SimulatorSettings.Time\x1aX\n\x04Time\x12\x1b\n\x0cuse_sim_time\x18\x01 \x01(\x08:\x05\x66\x61lse\x12\x16\n\x0bwarp_factor\x18\x02 \x01(\x05:\x01\x31\x12\x1b\n\x13reference_microtime\x18\x03 \x01(\x03\x1a\x31\n\x07Geodesy\x12\x12\n\nlat_origin\x18\x01 \x02(\x01\x12\x12\n\nlon_origin\x18\x02 \x02(\x01\x1a\x31\n\x06Health\x12\'\n\x19run_health_monitor_thread\x18\x01 \x01(\x08:\x04true\x1a\x1f\n\x04Tool\x12\x17\n\x0f\x65xtra_cli_param\x18\x01 \x03(\t\x1a\'\n\x0cIntervehicle\x12\x17\n\x0f\x64\x63\x63l_passphrase\x18\x01 \x01(\t')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n&gateway/goby/protobuf/app_config.proto\x12\x18goby.middleware.protobuf\x1a(gateway/goby/protobuf/debug_logger.proto\"\xbe\x05\n\tAppConfig\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x0e\n\x06\x62inary\x18\x02 \x01(\t\x12\x33\n\x0bglog_config\x18\n \x01(\x0b\x32\x1e.goby.util.protobuf.GLogConfig\x12I\n\nsimulation\x18\x14 \x01(\x0b\x32\x35.goby.middleware.protobuf.AppConfig.SimulatorSettings\x12<\n\x07geodesy\x18\x1e \x01(\x0b\x32+.goby.middleware.protobuf.AppConfig.Geodesy\x12>\n\nhealth_cfg\x18( \x01(\x0b\x32*.goby.middleware.protobuf.AppConfig.Health\x12:\n\x08tool_cfg\x18\x32 \x01(\x0b\x32(.goby.middleware.protobuf.AppConfig.Tool\x12\x18\n\tdebug_cfg\x18\x64 \x01(\x08:\x05\x66\x61lse\x1a\xb7\x01\n\x11SimulatorSettings\x12H\n\x04time\x18\x01 \x01(\x0b\x32:.goby.middleware.protobuf.AppConfig.SimulatorSettings.Time\x1aX\n\x04Time\x12\x1b\n\x0cuse_sim_time\x18\x01 \x01(\x08:\x05\x66\x61lse\x12\x16\n\x0bwarp_factor\x18\x02 \x01(\x05:\x01\x31\x12\x1b\n\x13reference_microtime\x18\x03 \x01(\x03\x1a\x31\n\x07Geodesy\x12\x12\n\nlat_origin\x18\x01 \x02(\x01\x12\x12\n\nlon_origin\x18\x02 \x02(\x01\x1a\x31\n\x06Health\x12\'\n\x19run_health_monitor_thread\x18\x01 \x01(\x08:\x04true\x1a\x1f\n\x04Tool\x12\x17\n\x0f\x65xtra_cli_param\x18\x01 \x03(\t')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
@@ -33,17 +33,15 @@ _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'gateway.goby.protobuf.app_c
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
   _globals['_APPCONFIG']._serialized_start=111
-  _globals['_APPCONFIG']._serialized_end=984
-  _globals['_APPCONFIG_SIMULATORSETTINGS']._serialized_start=625
-  _globals['_APPCONFIG_SIMULATORSETTINGS']._serialized_end=808
-  _globals['_APPCONFIG_SIMULATORSETTINGS_TIME']._serialized_start=720
-  _globals['_APPCONFIG_SIMULATORSETTINGS_TIME']._serialized_end=808
-  _globals['_APPCONFIG_GEODESY']._serialized_start=810
-  _globals['_APPCONFIG_GEODESY']._serialized_end=859
-  _globals['_APPCONFIG_HEALTH']._serialized_start=861
-  _globals['_APPCONFIG_HEALTH']._serialized_end=910
-  _globals['_APPCONFIG_TOOL']._serialized_start=912
-  _globals['_APPCONFIG_TOOL']._serialized_end=943
-  _globals['_APPCONFIG_INTERVEHICLE']._serialized_start=945
-  _globals['_APPCONFIG_INTERVEHICLE']._serialized_end=984
+  _globals['_APPCONFIG']._serialized_end=813
+  _globals['_APPCONFIG_SIMULATORSETTINGS']._serialized_start=495
+  _globals['_APPCONFIG_SIMULATORSETTINGS']._serialized_end=678
+  _globals['_APPCONFIG_SIMULATORSETTINGS_TIME']._serialized_start=590
+  _globals['_APPCONFIG_SIMULATORSETTINGS_TIME']._serialized_end=678
+  _globals['_APPCONFIG_GEODESY']._serialized_start=680
+  _globals['_APPCONFIG_GEODESY']._serialized_end=729
+  _globals['_APPCONFIG_HEALTH']._serialized_start=731
+  _globals['_APPCONFIG_HEALTH']._serialized_end=780
+  _globals['_APPCONFIG_TOOL']._serialized_start=782
+  _globals['_APPCONFIG_TOOL']._serialized_end=813
 # @@protoc_insertion_point(module_scope)

@@ -8,7 +8,7 @@ from typing import ClassVar as _ClassVar, Optional as _Optional, Union as _Union
 DESCRIPTOR: _descriptor.FileDescriptor
 
 class AppConfig(_message.Message):
-    __slots__ = ("name", "binary", "loop_frequency", "glog_config", "simulation", "geodesy", "health_cfg", "tool_cfg", "load_shared_library", "debug_cfg", "intervehicle_cfg")
+    __slots__ = ("name", "binary", "glog_config", "simulation", "geodesy", "health_cfg", "tool_cfg", "debug_cfg")
     class SimulatorSettings(_message.Message):
         __slots__ = ("time",)
         class Time(_message.Message):
@@ -40,31 +40,20 @@ class AppConfig(_message.Message):
         EXTRA_CLI_PARAM_FIELD_NUMBER: _ClassVar[int]
         extra_cli_param: _containers.RepeatedScalarFieldContainer[str]
         def __init__(self, extra_cli_param: _Optional[_Iterable[str]] = ...) -> None: ...
-    class Intervehicle(_message.Message):
-        __slots__ = ("dccl_passphrase",)
-        DCCL_PASSPHRASE_FIELD_NUMBER: _ClassVar[int]
-        dccl_passphrase: str
-        def __init__(self, dccl_passphrase: _Optional[str] = ...) -> None: ...
     NAME_FIELD_NUMBER: _ClassVar[int]
     BINARY_FIELD_NUMBER: _ClassVar[int]
-    LOOP_FREQUENCY_FIELD_NUMBER: _ClassVar[int]
     GLOG_CONFIG_FIELD_NUMBER: _ClassVar[int]
     SIMULATION_FIELD_NUMBER: _ClassVar[int]
     GEODESY_FIELD_NUMBER: _ClassVar[int]
     HEALTH_CFG_FIELD_NUMBER: _ClassVar[int]
     TOOL_CFG_FIELD_NUMBER: _ClassVar[int]
-    LOAD_SHARED_LIBRARY_FIELD_NUMBER: _ClassVar[int]
     DEBUG_CFG_FIELD_NUMBER: _ClassVar[int]
-    INTERVEHICLE_CFG_FIELD_NUMBER: _ClassVar[int]
     name: str
     binary: str
-    loop_frequency: float
     glog_config: _debug_logger_pb2.GLogConfig
     simulation: AppConfig.SimulatorSettings
     geodesy: AppConfig.Geodesy
     health_cfg: AppConfig.Health
     tool_cfg: AppConfig.Tool
-    load_shared_library: _containers.RepeatedScalarFieldContainer[str]
     debug_cfg: bool
-    intervehicle_cfg: AppConfig.Intervehicle
-    def __init__(self, name: _Optional[str] = ..., binary: _Optional[str] = ..., loop_frequency: _Optional[float] = ..., glog_config: _Optional[_Union[_debug_logger_pb2.GLogConfig, _Mapping]] = ..., simulation: _Optional[_Union[AppConfig.SimulatorSettings, _Mapping]] = ..., geodesy: _Optional[_Union[AppConfig.Geodesy, _Mapping]] = ..., health_cfg: _Optional[_Union[AppConfig.Health, _Mapping]] = ..., tool_cfg: _Optional[_Union[AppConfig.Tool, _Mapping]] = ..., load_shared_library: _Optional[_Iterable[str]] = ..., debug_cfg: _Optional[bool] = ..., intervehicle_cfg: _Optional[_Union[AppConfig.Intervehicle, _Mapping]] = ...) -> None: ...
+    def __init__(self, name: _Optional[str] = ..., binary: _Optional[str] = ..., glog_config: _Optional[_Union[_debug_logger_pb2.GLogConfig, _Mapping]] = ..., simulation: _Optional[_Union[AppConfig.SimulatorSettings, _Mapping]] = ..., geodesy: _Optional[_Union[AppConfig.Geodesy, _Mapping]] = ..., health_cfg: _Optional[_Union[AppConfig.Health, _Mapping]] = ..., tool_cfg: _Optional[_Union[AppConfig.Tool, _Mapping]] = ..., debug_cfg: _Optional[bool] = ...) -> None: ...
