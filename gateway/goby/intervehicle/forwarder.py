@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from google.protobuf.message import Message
@@ -48,6 +48,7 @@ class _Pending:
     on_expire: Callable[[Any, Any], None] | None
     serialize_time: int
     expired: bool = False
+    acked_by: set[int] = field(default_factory=set)
 
 
 @dataclass(eq=False)
@@ -221,8 +222,12 @@ class InterVehicleForwarder:
         return stm_key(stm)
 
     def _on_ack(self, pair: AckMessagePair) -> None:
-        pending = self._pending.pop(self._key_of(pair.serializer), None)
-        if pending is None or pending.on_ack is None:
+        """One ack per acking modem (a publication to several subscribers is acked by each), as Goby."""
+        pending = self._pending.get(self._key_of(pair.serializer))
+        if pending is None or pair.data.header.src in pending.acked_by:
+            return
+        pending.acked_by.add(pair.data.header.src)
+        if pending.on_ack is None:
             return
         try:
             pending.on_ack(pending.msg, pair.data)

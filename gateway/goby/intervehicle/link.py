@@ -78,7 +78,8 @@ class LinkOutputs:
     expire_in: Callable[[ExpireMessagePair], None] = lambda _m: None
     subscription_rx: Callable[[Subscription], None] = lambda _m: None
     subscription_report: Callable[[SubscriptionReport], None] = lambda _m: None
-    transmitted: Callable[[ModemTransmission], None] = lambda _m: None
+    transmitted: Callable[[ModemTransmission], None] = lambda _m: None  # a data transmission we sent
+    initiated: Callable[[ModemTransmission], None] = lambda _m: None  # the MAC started one of our slots
 
 
 @dataclass
@@ -161,6 +162,7 @@ class Link:
 
     def _initiate(self, slot: ModemTransmission) -> None:
         self.counters.slot_starts.append(slot.time / 1e6)
+        self.out.initiated(slot)
         self.driver.handle_initiate_transmission(slot)
 
     # ------------------------------------------------------------------------------------- publishing

@@ -18,10 +18,16 @@ from gateway.goby.acomms.driver import ModemDriver
 from gateway.goby.acomms.errors import AcommsError, ModemConfigError
 from gateway.goby.acomms.ether import Ether, EtherDriver
 from gateway.goby.acomms.protobuf.driver_base_pb2 import DRIVER_UDP_MULTICAST, DriverConfig
+from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
 from gateway.goby.acomms.udp_multicast import UDPMulticastDriver
 from gateway.goby.intervehicle import groups
 from gateway.goby.intervehicle.link import Link, LinkConfig, LinkOutputs
-from gateway.goby.intervehicle.protobuf.intervehicle_pb2 import PortalConfig, Subscription, SubscriptionReport
+from gateway.goby.intervehicle.protobuf.intervehicle_pb2 import (
+    ModemTransmissionWithLinkID,
+    PortalConfig,
+    Subscription,
+    SubscriptionReport,
+)
 from gateway.goby.intervehicle.protobuf.serializer_transporter_pb2 import SerializerTransporterMessage
 from gateway.goby.portal.context import ProcessContext, use_context
 from gateway.goby.portal.thread import SimpleThread
@@ -63,12 +69,17 @@ class LinkThread(SimpleThread):
             expire_in=lambda m: ip.publish(groups.modem_expire_in, m),
             subscription_rx=lambda m: ip.publish(groups.modem_subscription_forward_rx, m),
             subscription_report=lambda m: ip.publish(groups.subscription_report, m),
+            transmitted=lambda m: ip.publish(groups.modem_transmit_result, self._with_id(m)),
+            initiated=lambda m: ip.publish(groups.mac_initiate_transmission, self._with_id(m)),
         )
         self.link = Link(cfg, driver, self.context.clock.now, outputs)
         ip.subscribe(groups.modem_data_out, SerializerTransporterMessage, self.link.buffer_message)
         ip.subscribe(groups.modem_subscription_forward_tx, Subscription, self.link.forward_subscription)
         ip.subscribe(groups.modem_subscription_forward_rx, Subscription, self.link.accept_subscription)
         self._announce = [time.monotonic() + s for s in ANNOUNCE_AGAIN_S]
+
+    def _with_id(self, msg: ModemTransmission) -> ModemTransmissionWithLinkID:
+        return ModemTransmissionWithLinkID(link_modem_id=self.link.modem_id, data=msg)
 
     def initialize(self) -> None:
         self.link.start()
