@@ -19,7 +19,7 @@ SHIPPED_APPLICATIONS: dict[str, list[str]] = {
     "moos-gateway-node-report-plugin": ["translators.node_report"],
     "goby-helm-example": ["behaviors.apps.goby_helm_example"],
     "usv-mission-shore": ["launch.usv.shore"],
-    "usv-mission-recorder": ["launch.usv.recorder"],
+    "usv-mission-recorder": ["launch.recorder"],
 }
 
 

@@ -10,8 +10,8 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from launch.record import Event, MissionRecord, NavSample
 from launch.usv.geometry import Point, Polygon, parse_points, parse_polygon, radial_polygon
-from launch.usv.record import Event, MissionRecord, NavSample
 
 COMMAND_VARS = ("POLYGON_UPDATES", "DEPLOY_STATE")
 SETTLED_WITHIN_M = 15.0

@@ -8,52 +8,25 @@ from __future__ import annotations
 
 import logging
 import re
-import shutil
 import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from launch.errors import LaunchError, MissionConfigError, ProcessDiedError
+from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import parse_file
 from launch.liaison.portal_side import READY_PREFIX as LIAISON_READY
-from launch.process_group import ManagedProcess, ProcessGroup, child_environment
-from launch.usv.record import MissionRecord, shifted
-from launch.usv.recorder import MoosRecorder, PortalRecorder, SimClock
+from launch.mission import ProcessOutcome, choose_program, outcomes, scan_logs
+from launch.process_group import ProcessGroup, child_environment
+from launch.record import MissionRecord, shifted
+from launch.recorder import MoosRecorder, PortalRecorder, SimClock
 from launch.usv.settings import USV_DIR, UsvSettings
 
 log = logging.getLogger(__name__)
 
 LAUNCH_FILE = USV_DIR / "usv.launch"
-# Lines that count as an unexpected error in a process log.
-ERROR_PATTERN = re.compile(r"Traceback|\bERROR\b|\bCRITICAL\b|\bFATAL\b|Segmentation fault|core dumped", re.I)
-# Errors that are part of a normal run (none yet; add with a comment saying why).
-EXPECTED_ERRORS: tuple[re.Pattern[str], ...] = ()
-
-
-def choose_program(choice: str, real: str, ours: str) -> str:
-    """``auto``: the real MOOS-IvP program when it is on PATH, else ours; ``real``/``ours`` force one."""
-    if choice == "ours":
-        return ours
-    found = shutil.which(real)
-    if choice == "real":
-        if not found:
-            raise MissionConfigError(f"{real} was asked for but is not on PATH")
-        return real
-    if choice != "auto":
-        raise MissionConfigError(f"choose auto, real or ours, not {choice!r}")
-    return real if found else ours
-
-
-@dataclass
-class ProcessOutcome:
-    """How one process ended."""
-
-    name: str
-    returncode: int | None
-    clean: bool
-    log_path: Path
+__all__ = ["LAUNCH_FILE", "MissionResult", "UsvMission", "choose_program"]
 
 
 @dataclass
@@ -65,21 +38,6 @@ class MissionResult:
     outcomes: list[ProcessOutcome] = field(default_factory=list)
     log_errors: list[str] = field(default_factory=list)
     failure: str | None = None
-
-
-def scan_logs(processes: list[ManagedProcess]) -> list[str]:
-    """Unexpected error lines, as ``name: line``, from every process log."""
-    found = []
-    for process in processes:
-        try:
-            lines = process.log_path.read_text(errors="replace").splitlines()
-        except OSError as exc:
-            found.append(f"{process.name}: log unreadable: {exc}")
-            continue
-        for line in lines:
-            if ERROR_PATTERN.search(line) and not any(p.search(line) for p in EXPECTED_ERRORS):
-                found.append(f"{process.name}: {line.strip()}")
-    return found
 
 
 class UsvMission:
@@ -123,11 +81,11 @@ class UsvMission:
         self.group.stop_event = self.stop_event
         # The MOOS client retries until the MOOSDB is up, so it sees everything from the first posting; its mail
         # is read while the launch waits between processes, so start-up events get their real times.
-        self.moos = MoosRecorder(self.record, self.clock, self.settings)
+        self.moos = MoosRecorder(self.record, self.clock, self.settings.moos_port)
         self.moos.start()
         self.group.on_wait = self.moos.poll
         self.group.start()
-        self.portal = PortalRecorder(self.record, self.clock, self.settings)
+        self.portal = PortalRecorder(self.record, self.clock, self.settings.platform, self.settings.ipc_base)
         self.portal.start()
 
     def liaison_urls(self, timeout_s: float = 30.0) -> dict[str, str]:
@@ -220,16 +178,14 @@ class UsvMission:
             self.moos.close()
         if self.portal is not None:
             self.portal.close()
-        outcomes: list[ProcessOutcome] = []
+        ended: list[ProcessOutcome] = []
         errors: list[str] = []
         if self.group is not None:
             self.group.stop()
-            for process in self.group.processes:
-                outcomes.append(ProcessOutcome(process.name, process.returncode, process.exited_cleanly,
-                                               process.log_path))
+            ended = outcomes(self.group.processes)
             errors = scan_logs(self.group.processes)
         t0 = self.command_time or 0.0
-        self._stopped_result = MissionResult(shifted(self.record, t0), self.command_time, outcomes, errors, failure)
+        self._stopped_result = MissionResult(shifted(self.record, t0), self.command_time, ended, errors, failure)
         return self._stopped_result
 
     def __enter__(self) -> UsvMission:

@@ -10,9 +10,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402 - the backend must be chosen first
 
+from launch.record import NavSample  # noqa: E402
 from launch.usv.analysis import CommandEffect, LoiterPhase  # noqa: E402
 from launch.usv.geometry import Point  # noqa: E402
-from launch.usv.record import NavSample  # noqa: E402
 
 PHASE_COLOURS = {"POLYGON": "tab:blue", "WAYPOINTS": "tab:orange"}
 

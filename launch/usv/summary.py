@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from launch.record import MissionRecord
 from launch.usv.analysis import (
     command_effects,
     helm_timeline,
@@ -15,7 +16,6 @@ from launch.usv.analysis import (
 )
 from launch.usv.geometry import Point
 from launch.usv.mission import MissionResult
-from launch.usv.record import MissionRecord
 
 
 def progress_line(record: MissionRecord, elapsed: float, duration: float | None) -> str:

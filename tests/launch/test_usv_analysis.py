@@ -7,6 +7,7 @@ import math
 
 import pytest
 
+from launch.record import MissionRecord, shifted
 from launch.usv.analysis import (
     bhv_waypoints,
     command_effects,
@@ -17,7 +18,6 @@ from launch.usv.analysis import (
 from launch.usv.geometry import parse_points, parse_polygon, radial_polygon
 from launch.usv.mission import MissionResult
 from launch.usv.plot import write_track_png
-from launch.usv.record import MissionRecord, shifted
 from launch.usv.settings import UsvSettings
 from launch.usv.summary import progress_line, summary_text
 

@@ -1,6 +1,6 @@
 """What the demo saw during a mission, in sim seconds: the track and every interesting posting.
 
-The recorder (``launch.usv.recorder``) fills a ``MissionRecord`` from MOOS mail and portal messages;
+The recorder (``launch.recorder``) fills a ``MissionRecord`` from MOOS mail and portal messages;
 ``launch.usv.analysis`` and ``launch.usv.plot`` read it. Kept free of I/O so analyses are testable
 with hand-made records.
 """
@@ -22,6 +22,7 @@ class NavSample:
     y: float
     heading: float | None = None
     speed: float | None = None
+    depth: float | None = None
 
 
 @dataclass(frozen=True)
@@ -46,6 +47,7 @@ class MissionRecord:
     _y: float | None = field(default=None, repr=False)
     _heading: float | None = field(default=None, repr=False)
     _speed: float | None = field(default=None, repr=False)
+    _depth: float | None = field(default=None, repr=False)
 
     def add_nav(self, t: float, name: str, value: float) -> None:
         """Fold one NAV_* value in; a position row is added (or its newest row updated) per update."""
@@ -58,11 +60,13 @@ class MissionRecord:
                 self._heading = value
             elif name == "NAV_SPEED":
                 self._speed = value
+            elif name == "NAV_DEPTH":
+                self._depth = value
             else:
                 return
             if self._x is None or self._y is None:
                 return
-            sample = NavSample(t, self._x, self._y, self._heading, self._speed)
+            sample = NavSample(t, self._x, self._y, self._heading, self._speed, self._depth)
             if self.nav and abs(self.nav[-1].t - t) < 1e-6:
                 self.nav[-1] = sample
             else:
@@ -109,6 +113,6 @@ def shifted(record: MissionRecord, dt: float) -> MissionRecord:
     """A copy with every time moved by ``-dt`` (so t=0 can be the moment the helm took command)."""
     nav, events = record.snapshot()
     out = MissionRecord()
-    out.nav = [NavSample(s.t - dt, s.x, s.y, s.heading, s.speed) for s in nav]
+    out.nav = [NavSample(s.t - dt, s.x, s.y, s.heading, s.speed, s.depth) for s in nav]
     out.events = [Event(e.t - dt, e.source, e.name, e.value, e.origin) for e in events]
     return out

@@ -1,4 +1,4 @@
-"""Record a running USV mission from inside the demo process: a MOOS client and a portal subscriber.
+"""Record a running mission from inside the demo process: a MOOS client and a portal subscriber per vehicle.
 
 The MOOS side gives the track (NAV_*), the helm (IVPHELM_STATE, VIEW_*) and what commands posted
 (DEPLOY_STATE, POLYGON_UPDATES, with their posters); the portal side gives the frontseat interface's
@@ -18,12 +18,11 @@ from frontseat.protobuf.frontseat_pb2 import InterfaceState, InterfaceStatus
 from gateway.goby.portal import SimpleThread
 from gateway.moos import MoosClock, comms
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
-from launch.usv.record import MissionRecord
-from launch.usv.settings import UsvSettings
+from launch.record import MissionRecord
 
 log = logging.getLogger(__name__)
 
-NAV_VARS = ("NAV_X", "NAV_Y", "NAV_HEADING", "NAV_SPEED")
+NAV_VARS = ("NAV_X", "NAV_Y", "NAV_HEADING", "NAV_SPEED", "NAV_DEPTH")
 EVENT_VARS = (
     "DEPLOY_STATE",
     "POLYGON_UPDATES",
@@ -32,6 +31,8 @@ EVENT_VARS = (
     "VIEW_SEGLIST",
     "LOITER_MODE",
     "WPT_INDEX",
+    "AUV_DEPLOY_STATE",
+    "DEPLOY_DEPTH_UPDATES",
 )
 # Posted every helm iteration; only changes are worth keeping. (Command variables are kept every time:
 # the same command twice is two commands.)
@@ -56,12 +57,12 @@ class MoosRecorder:
     queues mail, as the pymoos contract wants.
     """
 
-    def __init__(self, record: MissionRecord, clock: SimClock, settings: UsvSettings, name: str = "uUsvDemoRecorder"):
+    def __init__(self, record: MissionRecord, clock: SimClock, moos_port: int, name: str = "uUsvDemoRecorder"):
         self.record = record
         self.clock = clock
-        self.settings = settings
+        self.moos_port = moos_port
         self.name = name
-        self.comms = comms(clock=MoosClock(settings.warp))
+        self.comms = comms(clock=MoosClock(clock.warp))
         self.comms.set_on_connect_callback(self._on_connect)
         self.mail_count = 0
         self._last: dict[str, str] = {}
@@ -72,7 +73,7 @@ class MoosRecorder:
         return True
 
     def start(self) -> None:
-        self.comms.run("127.0.0.1", self.settings.moos_port, self.name)
+        self.comms.run("127.0.0.1", self.moos_port, self.name)
 
     def connected(self) -> bool:
         return self.comms.is_connected()
@@ -129,17 +130,17 @@ class _PortalListener(SimpleThread):
 class PortalRecorder:
     """Runs the portal listener on its own thread (built there, as portal threads own their sockets)."""
 
-    def __init__(self, record: MissionRecord, clock: SimClock, settings: UsvSettings) -> None:
+    def __init__(self, record: MissionRecord, clock: SimClock, platform: str, ipc_base: str) -> None:
         self._cfg = GobyMOOSGatewayConfig()
         self._cfg.app.name = "usv-demo-recorder"
-        self._cfg.interprocess.platform = settings.platform
-        self._cfg.interprocess.socket_name = settings.ipc_base
+        self._cfg.interprocess.platform = platform
+        self._cfg.interprocess.socket_name = ipc_base
         self._record = record
         self._clock = clock
         self._listener: _PortalListener | None = None
         self._lock = threading.Lock()
         self._closing = False
-        self._thread = threading.Thread(target=self._run, name="usv-demo-portal", daemon=True)
+        self._thread = threading.Thread(target=self._run, name=f"{platform}-demo-portal", daemon=True)
         self.error: BaseException | None = None
 
     def _run(self) -> None:

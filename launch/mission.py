@@ -1,0 +1,65 @@
+"""What every mission runner shares: choosing real or our MOOS programs, how processes ended, error lines in logs."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from launch.errors import MissionConfigError
+from launch.process_group import ManagedProcess
+
+# Lines that count as an unexpected error in a process log.
+ERROR_PATTERN = re.compile(r"Traceback|\bERROR\b|\bCRITICAL\b|\bFATAL\b|Segmentation fault|core dumped", re.I)
+# Errors that are part of a normal run (none yet; add with a comment saying why).
+EXPECTED_ERRORS: tuple[re.Pattern[str], ...] = ()
+
+
+def choose_program(choice: str, real: str, ours: str) -> str:
+    """``auto``: the real MOOS-IvP program when it is on PATH, else ours; ``real``/``ours`` force one."""
+    if choice == "ours":
+        return ours
+    found = shutil.which(real)
+    if choice == "real":
+        if not found:
+            raise MissionConfigError(f"{real} was asked for but is not on PATH")
+        return real
+    if choice != "auto":
+        raise MissionConfigError(f"choose auto, real or ours, not {choice!r}")
+    return real if found else ours
+
+
+@dataclass
+class ProcessOutcome:
+    """How one process ended."""
+
+    name: str
+    returncode: int | None
+    clean: bool
+    log_path: Path
+
+
+def outcomes(processes: Iterable[ManagedProcess]) -> list[ProcessOutcome]:
+    return [ProcessOutcome(p.name, p.returncode, p.exited_cleanly, p.log_path) for p in processes]
+
+
+def scan_log_files(logs: Iterable[tuple[str, Path]]) -> list[str]:
+    """Unexpected error lines, as ``name: line``, from each (name, log path)."""
+    found = []
+    for name, path in logs:
+        try:
+            lines = path.read_text(errors="replace").splitlines()
+        except OSError as exc:
+            found.append(f"{name}: log unreadable: {exc}")
+            continue
+        for line in lines:
+            if ERROR_PATTERN.search(line) and not any(p.search(line) for p in EXPECTED_ERRORS):
+                found.append(f"{name}: {line.strip()}")
+    return found
+
+
+def scan_logs(processes: Iterable[ManagedProcess]) -> list[str]:
+    """Unexpected error lines from every process log."""
+    return scan_log_files((p.name, p.log_path) for p in processes)

@@ -1,0 +1,268 @@
+"""Run the trail mission (or one platform of it) from Python: its launch lines, a recorder per vehicle, the stop.
+
+Used by the demo (``launch.trail.demo``), the mission test and the fleet benchmark, so all run exactly what
+``./all.launch`` runs: the same nested ``goby-launch`` lines (``generate_all_launch.all_launch_text``) with the
+same generated configs. Each vehicle with a MOOSDB gets a MOOS client (track, helm and command variables) and a
+portal subscriber on its broker (the frontseat interface's state); all events share one clock, sim seconds since
+the recorders started, so vehicles and commands line up.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from launch.apps.goby_launch import LAUNCH_DIR_VAR, LOG_DIR_VAR, PLATFORM_VAR
+from launch.errors import LaunchError, ProcessDiedError
+from launch.launchfile import LaunchEntry, parse_file, parse_lines
+from launch.mission import ProcessOutcome, outcomes, scan_log_files
+from launch.process_group import ProcessGroup, child_environment
+from launch.record import MissionRecord, shifted
+from launch.recorder import MoosRecorder, PortalRecorder, SimClock
+from launch.trail.generate_all_launch import all_launch_text
+from launch.trail.settings import AUV_INDEX_VAR, N_AUVS_VAR, TRAIL_DIR, TrailSettings, Vehicle
+
+log = logging.getLogger(__name__)
+
+COMMAND_STATE = "INTERFACE_COMMAND"
+
+
+def fleet(n_auvs: int) -> list[Vehicle]:
+    """Every platform of an all.launch run, in launch order."""
+    return [Vehicle("topside", n_auvs), Vehicle("usv", n_auvs), *(Vehicle("auv", n_auvs, i) for i in range(n_auvs))]
+
+
+def all_launch_entries(n_auvs: int) -> list[LaunchEntry]:
+    return parse_lines(all_launch_text(n_auvs, launch_dir=str(TRAIL_DIR)).splitlines(), source="all.launch").entries
+
+
+def platform_entries(vehicle: Vehicle) -> list[LaunchEntry]:
+    """One platform's launch file as its own run (what ``goby-launch usv.launch`` runs)."""
+    return parse_file(TRAIL_DIR / f"{vehicle.kind}.launch").entries
+
+
+@dataclass
+class VehicleRun:
+    """One vehicle's recorders and what they saw."""
+
+    vehicle: Vehicle
+    record: MissionRecord = field(default_factory=MissionRecord)
+    moos: MoosRecorder | None = None
+    portal: PortalRecorder | None = None
+
+    def interface_states(self) -> list[str]:
+        return [e.value for e in self.record.events_named("interface_state", source="interface")]
+
+    def command_time(self) -> float | None:
+        return next((e.t for e in self.record.events_named("interface_state", source="interface")
+                     if e.value == COMMAND_STATE), None)
+
+
+@dataclass
+class TrailResult:
+    """What the demo prints and the tests assert: per-vehicle records (t=0 when the last vehicle reached COMMAND),
+    how every launcher and process ended, unexpected error lines, and what failed."""
+
+    records: dict[str, MissionRecord]
+    command_times: dict[str, float | None]
+    t0: float
+    outcomes: list[ProcessOutcome] = field(default_factory=list)
+    log_errors: list[str] = field(default_factory=list)
+    failure: str | None = None
+    extra: dict[str, object] = field(default_factory=dict)
+
+
+class TrailMission:
+    """One run. ``start()``, ``wait_for_command()``, ``run()``, and always ``stop()`` (or use ``with``).
+
+    ``entries`` defaults to all.launch for ``n_auvs``; ``vehicles`` (default: the whole fleet) are the ones
+    recorded. The run's environment is the settings' ``TRAIL_*`` variables, so every config line agrees.
+    """
+
+    def __init__(
+        self,
+        settings: TrailSettings,
+        n_auvs: int,
+        *,
+        entries: Sequence[LaunchEntry] | None = None,
+        vehicles: Sequence[Vehicle] | None = None,
+        extra_env: dict[str, str] | None = None,
+        report: Callable[[str], None] = print,
+        launch_delay_s: float = 1.0,
+        platform: str = "trail",
+    ) -> None:
+        self.settings = settings
+        self.n_auvs = n_auvs
+        self.entries = list(entries) if entries is not None else all_launch_entries(n_auvs)
+        self.extra_env = dict(extra_env or {})
+        self.report = report
+        self.launch_delay_s = launch_delay_s
+        self.platform = platform
+        self.clock = SimClock(settings.warp)
+        self.runs = {v.name: VehicleRun(v) for v in (vehicles if vehicles is not None else fleet(n_auvs))}
+        self.group: ProcessGroup | None = None
+        self.log_dir = settings.run_dir / "logs" / "launch"
+        # Set from any thread or a signal handler to end start-up, the wait for COMMAND, or the run.
+        self.stop_event = threading.Event()
+        self.t0: float | None = None
+        self._result: TrailResult | None = None
+        self._hooks: list[Callable[[], None]] = []
+
+    # -- start -------------------------------------------------------------------------------------------------
+
+    def environment(self) -> dict[str, str]:
+        env = child_environment() | self.settings.to_env() | self.extra_env
+        env[LAUNCH_DIR_VAR] = str(TRAIL_DIR)
+        env[LOG_DIR_VAR] = str(self.log_dir)
+        env[PLATFORM_VAR] = self.platform
+        env.setdefault(N_AUVS_VAR, str(self.n_auvs))
+        return env
+
+    def start(self) -> None:
+        """Start the MOOS recorders (they retry until their MOOSDB is up), the launch lines, then the portal ones."""
+        self.settings.run_dir.mkdir(parents=True, exist_ok=True)
+        self.group = ProcessGroup(
+            self.entries,
+            self.log_dir,
+            platform=self.platform,
+            launch_delay_s=self.launch_delay_s,
+            kill_timeout_s=30.0,
+            base_env=self.environment(),
+            cwd=self.settings.run_dir,
+            report=self.report,
+            parallel_stop=True,
+        )
+        self.group.stop_event = self.stop_event
+        for run in self.runs.values():
+            if run.vehicle.kind != "topside":
+                run.moos = MoosRecorder(run.record, self.clock, run.vehicle.moos_port(self.settings),
+                                        name=f"uTrailRecorder_{run.vehicle.name}")
+                run.moos.start()
+        self.group.on_wait = self.poll_moos
+        self.group.start()
+        for run in self.runs.values():
+            if run.vehicle.kind != "topside":
+                run.portal = PortalRecorder(run.record, self.clock, run.vehicle.name, run.vehicle.ipc_base(self.settings))
+                run.portal.start()
+
+    def add_hook(self, hook: Callable[[], None]) -> None:
+        """Called on every poll (the demo's commander and link counters)."""
+        self._hooks.append(hook)
+
+    # -- watch -------------------------------------------------------------------------------------------------
+
+    def poll_moos(self) -> None:
+        for run in self.runs.values():
+            if run.moos is not None:
+                run.moos.poll()
+
+    def poll(self) -> None:
+        """File new MOOS mail, run the hooks, and check that every launcher is alive (raises ProcessDiedError)."""
+        self.poll_moos()
+        for hook in self._hooks:
+            hook()
+        assert self.group is not None
+        died = self.group.check()
+        if died is not None:
+            raise ProcessDiedError(died.name, died.returncode, died.log_tail(40))
+        for run in self.runs.values():
+            if run.portal is not None and run.portal.error is not None:
+                raise LaunchError(f"the portal recorder of {run.vehicle.name} failed: {run.portal.error}")
+
+    def now(self) -> float:
+        return self.clock.now()
+
+    def missing_command(self) -> list[str]:
+        return [name for name, run in self.runs.items() if run.vehicle.kind != "topside" and run.command_time() is None]
+
+    def wait_for_command(self, timeout_s: float = 180.0, progress: Callable[[], None] | None = None) -> float | None:
+        """Block until every recorded vehicle's frontseat interface reports COMMAND; returns that sim time."""
+        deadline = time.monotonic() + timeout_s
+        next_progress = time.monotonic() + 5
+        while self.missing_command():
+            if self.stop_event.is_set():
+                return None
+            self.poll()
+            if time.monotonic() > deadline:
+                seen = {n: ", ".join(dict.fromkeys(self.runs[n].interface_states())) or "none"
+                        for n in self.missing_command()}
+                raise LaunchError(f"not under helm command within {timeout_s:g} s: "
+                                  + "; ".join(f"{n} (states seen: {s})" for n, s in seen.items())
+                                  + f"; logs in {self.log_dir}")
+            if progress is not None and time.monotonic() >= next_progress:
+                progress()
+                next_progress = time.monotonic() + 5
+            time.sleep(0.05)
+        times = [run.command_time() for run in self.runs.values() if run.vehicle.kind != "topside"]
+        self.t0 = max((t for t in times if t is not None), default=self.now())
+        return self.t0
+
+    def run(self, duration_s: float | None, progress: Callable[[float], None] | None = None,
+            progress_period_s: float = 5.0, until: Callable[[], bool] | None = None) -> None:
+        """Run for ``duration_s`` sim seconds after t0 (None: until stopped), or until ``until()`` is true."""
+        t0 = self.t0 if self.t0 is not None else self.wait_for_command()
+        if t0 is None:
+            return
+        next_progress = 0.0
+        while not self.stop_event.is_set():
+            self.poll()
+            elapsed = self.now() - t0
+            if progress is not None and time.monotonic() >= next_progress:
+                progress(elapsed)
+                next_progress = time.monotonic() + progress_period_s
+            if duration_s is not None and elapsed >= duration_s:
+                return
+            if until is not None and until():
+                return
+            time.sleep(0.1)
+
+    # -- stop --------------------------------------------------------------------------------------------------
+
+    def stop(self, failure: str | None = None) -> TrailResult:
+        """Stop the recorders, then the launch lines (each inner launcher stops its own processes first)."""
+        if self._result is not None:
+            return self._result
+        for run in self.runs.values():
+            if run.moos is not None:
+                run.moos.poll()
+                run.moos.close()
+            if run.portal is not None:
+                run.portal.close()
+        ended: list[ProcessOutcome] = []
+        if self.group is not None:
+            self.group.stop()
+            ended = outcomes(self.group.processes)
+        logs = sorted(self.log_dir.rglob("*.log")) if self.log_dir.is_dir() else []
+        errors = scan_log_files((str(p.relative_to(self.log_dir)), p) for p in logs)
+        t0 = self.t0 if self.t0 is not None else 0.0
+        self._result = TrailResult(
+            records={name: shifted(run.record, t0) for name, run in self.runs.items()},
+            command_times={name: (None if run.command_time() is None else run.command_time() - t0)  # type: ignore[operator]
+                           for name, run in self.runs.items()},
+            t0=t0,
+            outcomes=ended,
+            log_errors=errors,
+            failure=failure,
+        )
+        return self._result
+
+    def __enter__(self) -> TrailMission:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
+def auv_slice_env(vehicle: Vehicle) -> dict[str, str]:
+    """The course's variables for one AUV launched on its own."""
+    return {N_AUVS_VAR: str(vehicle.n_auvs), AUV_INDEX_VAR: str(vehicle.index)}
+
+
+def log_path(mission: TrailMission, platform: str, program: str) -> Path:
+    """A process's log in a run: ``<log dir>/<platform>/<platform>.<program>.log`` (nested) or flat."""
+    nested = mission.log_dir / platform / f"{platform}.{program}.log"
+    return nested if nested.exists() else mission.log_dir / f"{platform}.{program}.log"
