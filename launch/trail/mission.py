@@ -10,6 +10,8 @@ the recorders started, so vehicles and commands line up.
 from __future__ import annotations
 
 import logging
+import random
+import socket
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -266,3 +268,34 @@ def log_path(mission: TrailMission, platform: str, program: str) -> Path:
     """A process's log in a run: ``<log dir>/<platform>/<platform>.<program>.log`` (nested) or flat."""
     nested = mission.log_dir / platform / f"{platform}.{program}.log"
     return nested if nested.exists() else mission.log_dir / f"{platform}.{program}.log"
+
+
+
+def _ports_free(ports: Sequence[int]) -> bool:
+    for port in ports:
+        with socket.socket() as sock:
+            try:
+                sock.bind(("127.0.0.1", port))
+            except OSError:
+                return False
+    return True
+
+
+def with_free_ports(settings: TrailSettings, n_auvs: int, prefer_course: bool = True) -> TrailSettings:
+    """The settings with MOOS/simulator/liaison port bases and link ports whose every port is free now.
+
+    The course's values first (when ``prefer_course``), else random ones, so side-by-side runs and tests do not
+    collide with a mission someone else is running.
+    """
+    ids = range(n_auvs + 2)
+    options = [(9000, 55000, 50000, 54500)] if prefer_course else []
+    rng = random.Random()
+    for _ in range(50):
+        base = rng.randrange(20000, 29000, 100)
+        options.append((base, base + 10000, base + 20000, base + 30000))
+    for moos, sim, liaison, link in options:
+        ports = [*(moos + i for i in ids), *(sim + i for i in ids), *(liaison + i for i in ids), link, link + 1]
+        if _ports_free(ports):
+            return settings.replace(moos_port_base=moos, sim_port_base=sim, liaison_port_base=liaison,
+                                    satellite_port=link, acomms_port=link + 1)
+    raise LaunchError("no free port range for the mission's MOOSDBs, simulators and pages")

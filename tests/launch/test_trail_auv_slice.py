@@ -1,0 +1,108 @@
+"""One AUV of the trail mission on its own: auv.launch's real processes (broker, frontseat simulator and interface,
+moos-db, ivp-helm with the rendered auv.bhv, node-reporter, the goby3_course gateway plugin, liaison).
+
+The USV's nav and the RECOVER command normally reach this AUV over the acoustic link, through the AUV manager,
+which republishes them on interprocess. Here a test double stands in for that hop: a portal client on the AUV's
+broker publishes ``goby3_course::usv_nav`` (NavigationReport, PROTOBUF scheme, as the manager does) for a USV
+driving east at 1.5 m/s, and later ``goby3_course::auv_command`` RECOVER. Everything after that hop is real.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import time
+
+from gateway.goby.portal import Scheme
+from gateway.goby.portal.testing import PortalClient
+from launch.launchfile import LaunchEntry
+from launch.trail.mission import TrailMission, auv_slice_env, platform_entries, with_free_ports
+from launch.trail.settings import TrailSettings, Vehicle
+from translators.trail import groups
+from translators.trail.protobuf.nav_dccl_pb2 import NavigationReport
+from translators.usv.protobuf.command_dccl_pb2 import AUVCommand
+
+WARP = 20
+USV_SPEED = 1.5
+
+
+def _installed(entries: list[LaunchEntry]) -> list[LaunchEntry]:
+    """The lines whose program is installed (the AUV manager is the one hop the test double replaces)."""
+    return [e for e in entries if not e.command.startswith("auv-manager") or shutil.which("auv-manager")]
+
+
+def test_one_auv_dives_trails_the_usv_contact_and_recovers(tmp_path):
+    vehicle = Vehicle("auv", 2, 1)  # index 1 of 2: trail angle 270 (the USV's port beam), depth 20 m
+    settings = with_free_ports(TrailSettings(run_dir=tmp_path, warp=WARP, socket_dir=tmp_path), 2,
+                               prefer_course=False)
+    entries = [e for e in _installed(platform_entries(vehicle)) if not e.command.startswith("auv-manager")]
+    mission = TrailMission(settings, 2, entries=entries, vehicles=[vehicle], extra_env=auv_slice_env(vehicle),
+                           platform=vehicle.name, launch_delay_s=0.1, report=lambda line: None)
+    usv_start = (0.0, 60.0)
+    client: PortalClient | None = None
+    state = {"last": -1e9, "t_recover": None}
+
+    def usv_position(t: float) -> tuple[float, float]:
+        return usv_start[0] + USV_SPEED * t, usv_start[1]
+
+    def publish_usv_nav() -> None:
+        now = mission.now()
+        if client is None or now - state["last"] < 2.0:
+            return
+        state["last"] = now
+        x, y = usv_position(now)
+        nav = NavigationReport(vehicle=1, time=time.time(), x=x, y=y, z=0, speed_over_ground=USV_SPEED, heading=90,
+                               type=NavigationReport.USV)
+        client.publish(groups.usv_nav, nav, scheme=Scheme.PROTOBUF)
+        client.poll()
+
+    try:
+        mission.start()
+        client = PortalClient(_interprocess(settings, vehicle), name="acomms_stand_in")
+        assert client.wait_ready(30)
+        mission.add_hook(publish_usv_nav)
+        mission.wait_for_command(timeout_s=120)
+        mission.run(400)
+        record = mission.runs[vehicle.name].record
+        nav = record.snapshot()[0]
+        t_end = mission.now()
+        # trailing: within the last 100 s, near the trail point 50 m off the USV's port beam, at 20 m
+        recent = [s for s in nav if s.t > t_end - 100]
+        ux, uy = usv_position(t_end)
+        last = nav[-1]
+        target = (ux, uy + 50.0)  # relative 270 with the USV heading east = north of it
+        miss = math.hypot(last.x - target[0], last.y - target[1])
+        assert miss < 25, f"AUV at ({last.x:.0f},{last.y:.0f}), trail point ({target[0]:.0f},{target[1]:.0f})"
+        assert all(s.depth is not None and abs(s.depth - 20) < 3 for s in recent), [s.depth for s in recent][-5:]
+        # RECOVER: the gateway posts depth=0 then AUV_DEPLOY_STATE=RECOVER; the AUV surfaces and heads for (100,-100)
+        client.publish(groups.auv_command, AUVCommand(time=time.time(), desired_state=AUVCommand.RECOVER))
+        client.poll()
+        t_recover = mission.now()
+        mission.run(None, until=lambda: mission.now() - t_recover > 200)
+        events = [(e.name, e.value) for e in record.snapshot()[1] if e.name in ("DEPLOY_DEPTH_UPDATES",
+                                                                             "AUV_DEPLOY_STATE") and e.t >= t_recover]
+        assert events[:2] == [("DEPLOY_DEPTH_UPDATES", "depth=0"), ("AUV_DEPLOY_STATE", "RECOVER")], events
+        final = record.snapshot()[0][-1]
+        assert final.depth is not None and final.depth < 2, final
+        start = next(s for s in record.snapshot()[0] if s.t >= t_recover)
+        before = math.hypot(start.x - 100, start.y + 100)
+        after = math.hypot(final.x - 100, final.y + 100)
+        assert after < before - 150 or after < 20, (before, after)
+    finally:
+        if client is not None:
+            client.close()
+        result = mission.stop()
+    assert result.command_times[vehicle.name] is not None
+    assert all(o.clean for o in result.outcomes), result.outcomes
+    assert not result.log_errors, result.log_errors[:10]
+
+
+def _interprocess(settings: TrailSettings, vehicle: Vehicle):
+    from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+
+    cfg = InterProcessPortalConfig()
+    cfg.platform = vehicle.name
+    cfg.socket_name = vehicle.ipc_base(settings)
+    return cfg
+
+
