@@ -254,6 +254,8 @@ GENERATORS: dict[str, Callable[[TrailSettings, Vehicle], str]] = {
     "frontseat_sim": _vehicle_only(("usv", "auv"), "frontseat_sim", lambda s, v: str(v.sim_port(s))),
     "frontseat_interface": _vehicle_only(("usv", "auv"), "frontseat_interface",
                                          _pb("frontseat_interface.pb.cfg.in", "frontseat-interface")),
+    "frontseat_tuning": _vehicle_only(("usv", "auv"), "frontseat_tuning",
+                                      _pb("frontseat_tuning.pb.cfg.in", "frontseat-interface")),
     "moos_gateway": _vehicle_only(("usv", "auv"), "moos_gateway", _pb("moos_gateway.pb.cfg.in", "moos-gateway")),
     "topside_manager": _manager("topside-manager", "topside"),
     "usv_manager": _manager("usv-manager", "usv"),
