@@ -53,7 +53,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--moos_address", default="127.0.0.1",
                         help="address to bind (default 127.0.0.1; 0.0.0.0 for every interface like the C++ DB)")
     parser.add_argument("--max_packet_bytes", type=int, default=64 * 1024 * 1024,
-                        help="largest packet accepted from a client before it is dropped")
+                        help="largest packet accepted from a client before it is dropped (also the most "
+                        "unfinished input one connection may buffer)")
+    parser.add_argument("--max_outbox_bytes", type=int, default=16 * 1024 * 1024,
+                        help="unsent bytes one client may have queued before it is dropped as too slow")
+    parser.add_argument("--max_buffered_bytes", type=int, default=256 * 1024 * 1024,
+                        help="input and output buffered for all connections together; past it the connection "
+                        "holding the most is dropped")
     parser.add_argument("--response", default="",
                         help="name:ms or pattern:ms, comma separated: ask those async clients to write no more "
                         "often than that (sent in the timing reply, as MOOSDB does)")
@@ -102,7 +108,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         response = parse_response(args.response)
         server = MoosDB(args.moos_address, port, community, time_warp=warp, client_timeout=timeout,
-                        max_packet_bytes=args.max_packet_bytes, response=response)
+                        max_packet_bytes=args.max_packet_bytes, max_outbox_bytes=args.max_outbox_bytes,
+                        max_buffered_bytes=args.max_buffered_bytes, response=response)
         server.start()
     except (OSError, ValueError) as exc:
         log.error("cannot start the MOOSDB on %s:%d: %s", args.moos_address, port, exc)

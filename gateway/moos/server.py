@@ -2,10 +2,13 @@
 
 One thread accepts, handshakes, reads, runs the database and writes, so packets from all clients are
 processed one at a time in arrival order (as the C++ central server thread does) without locks. Sockets are
-non-blocking; each connection has its own output queue. If a client stops reading and its queue passes
-``high_water`` bytes, the server stops reading from everyone (TCP then slows the senders down) until it
-drains; a client that makes no progress for ``stall_timeout`` seconds is dropped with a logged reason.
-Any client that sends bad bytes is dropped alone, with the reason logged; the others carry on.
+non-blocking and reads are never paused: a slow reader is handled alone. Each connection has its own
+bounded outbox (``max_outbox_bytes``); a client whose outbox overflows, or that takes nothing for
+``stall_timeout`` seconds while mail waits, is dropped and named (MOOSDB gives each client its own writer
+thread for the same reason, see docs/moos.md "Slow clients and memory"). Input is bounded per connection by
+``max_packet_bytes`` (a partial packet cannot grow past it) and all buffered input and output together by
+``max_buffered_bytes``: past it, the connection holding the most is dropped and named. Any client that sends
+bad bytes is dropped alone, with the reason logged; the others carry on.
 """
 
 from __future__ import annotations
@@ -16,6 +19,8 @@ import socket
 import threading
 import time as _time
 from collections import deque
+
+from util.memory import release_freed_memory
 
 from .clock import MoosClock
 from .codec import (
@@ -47,9 +52,10 @@ log = logging.getLogger(__name__)
 
 HANDSHAKE_TIMEOUT_S = 5.0
 RECV_BYTES = 256 * 1024
-HIGH_WATER = 4 * 1024 * 1024
-LOW_WATER = 1024 * 1024
+MAX_OUTBOX_BYTES = 16 * 1024 * 1024
+MAX_BUFFERED_BYTES = 256 * 1024 * 1024
 SEND_CHUNK = 1024 * 1024
+TRIM_AFTER_BYTES = 1024 * 1024
 
 _PROTOCOL, _HELLO, _READY, _CLOSED = range(4)
 
@@ -58,7 +64,7 @@ class _Client:
     """One accepted connection and its state."""
 
     __slots__ = ("sock", "peer", "state", "proto_buf", "reader", "name", "asynchronous", "last_rx", "accepted",
-                 "out", "out_bytes", "last_progress", "events")
+                 "out", "out_bytes", "last_progress", "events", "held")
 
     def __init__(self, sock: socket.socket, peer: str, max_packet_bytes: int) -> None:
         self.sock = sock
@@ -72,6 +78,7 @@ class _Client:
         self.out: deque[bytes] = deque()
         self.out_bytes = 0
         self.events = 0
+        self.held = 0  # input + output bytes buffered for this client, as last counted in the DB's total
 
     def label(self) -> str:
         return f"{to_str(self.name)!r} ({self.peer})" if self.name else self.peer
@@ -90,7 +97,8 @@ class MoosDB:
         max_packet_bytes: int = DEFAULT_MAX_PACKET_BYTES,
         stall_timeout: float = 6.0,
         handshake_timeout: float = HANDSHAKE_TIMEOUT_S,
-        high_water: int = HIGH_WATER,
+        max_outbox_bytes: int = MAX_OUTBOX_BYTES,
+        max_buffered_bytes: int = MAX_BUFFERED_BYTES,
         response: dict[str, float] | None = None,
     ) -> None:
         self.host = host
@@ -100,8 +108,10 @@ class MoosDB:
         self.client_timeout = float(client_timeout)
         self.stall_timeout = float(stall_timeout)
         self.handshake_timeout = float(handshake_timeout)
-        self.high_water = int(high_water)
-        self.low_water = min(LOW_WATER, self.high_water // 4)
+        self.max_outbox_bytes = int(max_outbox_bytes)
+        self.max_buffered_bytes = int(max_buffered_bytes)
+        self.buffered_bytes = 0  # input + output held for all connections
+        self._trim_due = False  # a big buffer was freed: give the memory back at the next check
         # MOOSDB's --response: client name or wildcard pattern -> seconds asked between the client's writes
         self.response = {to_bytes(k): float(v) for k, v in (response or {}).items()}
         self.max_packet_bytes = max_packet_bytes
@@ -115,8 +125,6 @@ class MoosDB:
         self._stopping = threading.Event()
         self._clients: dict[int, _Client] = {}
         self._by_name: dict[bytes, _Client] = {}
-        self._paused = False
-        self._congested: set[_Client] = set()
         self._lock = threading.Lock()
         self._recv_buf = bytearray(RECV_BYTES)
         self._recv_view = memoryview(self._recv_buf)
@@ -211,6 +219,9 @@ class MoosDB:
                 if now >= next_check:
                     next_check = now + 0.25
                     self._check_timeouts(now)
+                    if self._trim_due:
+                        self._trim_due = False
+                        release_freed_memory()
         except Exception:
             log.exception("MOOSDB I/O loop failed")
         finally:
@@ -245,7 +256,7 @@ class MoosDB:
         log.debug("accepted a connection from %s", client.peer)
 
     def _set_events(self, client: _Client) -> None:
-        want = (0 if self._paused else selectors.EVENT_READ) | (selectors.EVENT_WRITE if client.out else 0)
+        want = selectors.EVENT_READ | (selectors.EVENT_WRITE if client.out else 0)
         if want == client.events or client.state == _CLOSED:
             return
         sel = self._selector
@@ -268,7 +279,11 @@ class MoosDB:
             self._close(client, f"read failed: {exc}", fault=False)
             return
         if not n:
-            self._close(client, "closed the connection", fault=False)
+            partial = client.reader.pending_bytes or (client.state == _PROTOCOL and len(client.proto_buf))
+            if partial:
+                self._close(client, f"closed the connection in the middle of a packet ({partial} bytes unfinished)")
+            else:
+                self._close(client, "closed the connection", fault=False)
             return
         data = self._recv_view[:n]  # one reused buffer: a fresh 256 KiB bytes per recv would cost an mmap
         client.last_rx = _time.monotonic()
@@ -296,6 +311,7 @@ class MoosDB:
         for packet in packets:
             if client.state == _CLOSED or not self._on_packet(client, packet):
                 return
+        self._account(client)
 
     def _on_packet(self, client: _Client, packet: list[MoosMessage]) -> bool:
         if client.state == _HELLO:
@@ -406,12 +422,12 @@ class MoosDB:
             client.last_progress = _time.monotonic()
         client.out.append(data)
         client.out_bytes += len(data)
+        if client.out_bytes > self.max_outbox_bytes:
+            self._close(client, f"not keeping up: outbox full ({client.out_bytes} bytes unsent, "
+                        f"limit {self.max_outbox_bytes})")
+            return
         self._set_events(client)
-        if client.out_bytes > self.high_water and client not in self._congested:
-            self._congested.add(client)
-            log.warning("client %s is not keeping up (%d bytes queued); pausing reads from all clients",
-                        client.label(), client.out_bytes)
-            self._set_paused(True)
+        self._account(client)
 
     def _flush(self, client: _Client) -> None:
         while client.out:
@@ -438,23 +454,21 @@ class MoosDB:
                 client.out[0] = chunk[sent:]
                 break
             client.out.popleft()
-        if client in self._congested and client.out_bytes < self.low_water:
-            self._congested.discard(client)
-            if not self._congested:
-                self._set_paused(False)
         self._set_events(client)
+        self._account(client)
 
-    def _set_paused(self, paused: bool) -> None:
-        if paused == self._paused:
+    # ---- memory bounds -----------------------------------------------------------------------------
+    def _account(self, client: _Client) -> None:
+        """Update the total of buffered bytes with this client's; past ``max_buffered_bytes`` drop the biggest."""
+        if client.state == _CLOSED:
             return
-        self._paused = paused
-        now = _time.monotonic()
-        for client in list(self._clients.values()):
-            if not paused:
-                client.last_rx = now  # silence while we were not reading is not the client's fault
-            self._set_events(client)
-        if not paused:
-            log.info("output queues drained; reading from clients again")
+        held = client.reader.pending_bytes + client.out_bytes
+        self.buffered_bytes += held - client.held
+        client.held = held
+        while self.buffered_bytes > self.max_buffered_bytes and self._clients:
+            biggest = max(self._clients.values(), key=lambda c: c.held)
+            self._close(biggest, f"holds the most buffered data ({biggest.held} bytes) when all connections "
+                        f"together passed max_buffered_bytes ({self.max_buffered_bytes})")
 
     # ---- timeouts and closing ----------------------------------------------------------------------
     def _check_timeouts(self, now: float) -> None:
@@ -464,7 +478,7 @@ class MoosDB:
                     self._close(client, f"no handshake within {self.handshake_timeout:g} s")
             elif client.out_bytes and now - client.last_progress > self.stall_timeout:
                 self._close(client, f"not reading: {client.out_bytes} bytes unsent for {self.stall_timeout:g} s")
-            elif not self._paused and now - client.last_rx > self.client_timeout:
+            elif now - client.last_rx > self.client_timeout:
                 self._close(client, f"disconnecting after {self.client_timeout:g} seconds of silence")
 
     def _close(self, client: _Client, reason: str | None, fault: bool = True) -> None:
@@ -489,9 +503,12 @@ class MoosDB:
             client.sock.close()
         except OSError:
             pass
-        self._congested.discard(client)
-        if self._paused and not self._congested:
-            self._set_paused(False)
+        self.buffered_bytes -= client.held
+        self._trim_due |= client.held >= TRIM_AFTER_BYTES
+        client.held = 0
+        client.out.clear()
+        client.out_bytes = 0
+        client.reader = PacketReader(0)  # frees the partial packet now, not when the last reference goes
         if was_ready:
             with self._lock:
                 if self._by_name.get(client.name) is client:
