@@ -149,9 +149,8 @@ def test_tcp_transport_end_to_end(tmp_path: Path) -> None:
 
 
 def test_tcp_over_ipv6_loopback(tmp_path: Path) -> None:
-    with broker_process(tmp_path, platform="tcp6", tcp=True) as tcp_broker:
-        cfg = tcp_broker.interprocess_config()
-        cfg.ip_address = "::1"  # preferred over ipv4_address, bracketed in endpoints
+    with broker_process(tmp_path, platform="tcp6", tcp=True, address="::1") as tcp_broker:
+        cfg = tcp_broker.interprocess_config()  # ip_address is preferred over ipv4_address, bracketed in endpoints
         with PortalClient(cfg, "v6_client") as client:
             assert client.portal._pub_endpoint.startswith("tcp://[::1]:")
             got = client.collect("v6", Sample)

@@ -19,8 +19,10 @@ from gateway.errors import GatewayError
 from gateway.goby.portal.endpoints import (
     MANAGER_REQUEST_GROUP,
     MANAGER_RESPONSE_GROUP,
+    ip_address,
     ipc_base,
     manager_endpoint,
+    tcp_endpoint,
 )
 from gateway.goby.portal.errors import ClosedError, IdentifierError, PortalError
 from gateway.goby.portal.identifier import decode_frame, encode_frame, make_identifier, thread_id, type_prefix
@@ -89,9 +91,9 @@ class Broker:
     def endpoints(self) -> dict[str, str]:
         """Bound endpoints: ``xpub``, ``xsub``, ``manager``."""
         if self.is_tcp:
-            host = "127.0.0.1"
-            return {"xpub": f"tcp://{host}:{self.pub_port}", "xsub": f"tcp://{host}:{self.sub_port}",
-                    "manager": f"tcp://{host}:{self.manager_port}"}
+            host = ip_address(self.ipc)
+            return {"xpub": tcp_endpoint(host, self.pub_port), "xsub": tcp_endpoint(host, self.sub_port),
+                    "manager": tcp_endpoint(host, self.manager_port)}
         base = ipc_base(self.ipc)
         return {"xpub": f"ipc://{base}.xpub", "xsub": f"ipc://{base}.xsub", "manager": f"ipc://{base}.manager"}
 
@@ -116,9 +118,9 @@ class Broker:
             sock.setsockopt(zmq.IPV6, 1)
             sock.setsockopt(zmq.LINGER, 0)
         try:
-            if self.is_tcp:
-                self.pub_port = xpub.bind_to_random_port("tcp://*")
-                self.sub_port = xsub.bind_to_random_port("tcp://*")
+            if self.is_tcp:  # the configured address only (Goby's ipv4_address, default 127.0.0.1)
+                self.pub_port = xpub.bind_to_random_port(self._tcp_host())
+                self.sub_port = xsub.bind_to_random_port(self._tcp_host())
             else:
                 base = ipc_base(self.ipc)
                 xpub.bind(f"ipc://{base}.xpub")
@@ -143,9 +145,9 @@ class Broker:
         rep.setsockopt(zmq.LINGER, 0)
         rep.setsockopt(zmq.IPV6, 1)
         try:
-            endpoint = manager_endpoint(self.ipc, bind=True)
+            endpoint = manager_endpoint(self.ipc)
             if self.is_tcp and self.ipc.tcp_port == 0:
-                self.manager_port = rep.bind_to_random_port("tcp://*")
+                self.manager_port = rep.bind_to_random_port(self._tcp_host())
             else:
                 rep.bind(endpoint)
                 self.manager_port = self.ipc.tcp_port if self.is_tcp else 0
@@ -154,7 +156,7 @@ class Broker:
         except zmq.ZMQError as exc:
             rep.close()
             self.stop()
-            raise BrokerError(f"cannot bind the manager socket {manager_endpoint(self.ipc, True)}: {exc}") from exc
+            raise BrokerError(f"cannot bind the manager socket {manager_endpoint(self.ipc)}: {exc}") from exc
         stop_addr = f"inproc://broker-manager-stop-{id(self)}"
         stop_peer = self._mctx.socket(zmq.PAIR)
         stop_peer.bind(stop_addr)
@@ -180,6 +182,10 @@ class Broker:
         except GatewayError as exc:
             self.stop()
             raise BrokerError(f"cannot start the intervehicle portal: {exc}") from exc
+
+    def _tcp_host(self) -> str:
+        """``tcp://<configured address>`` for ``bind_to_random_port``."""
+        return tcp_endpoint(ip_address(self.ipc), 0).rsplit(":", 1)[0]
 
     def stop(self) -> None:
         """Stop both threads and close every socket; idempotent."""
@@ -231,6 +237,7 @@ class Broker:
         pub = self._mctx.socket(zmq.PUB)
         for sock in (sub, pub):
             sock.setsockopt(zmq.LINGER, 0)
+            sock.setsockopt(zmq.IPV6, 1)  # the proxy may be bound on an IPv6 address
         sub.connect(endpoints["xpub"])
         pub.connect(endpoints["xsub"])
         sub.setsockopt(zmq.SUBSCRIBE, type_prefix(

@@ -32,11 +32,11 @@ def tcp_endpoint(address: str, port: int) -> str:
     return f"tcp://{address}:{port}"
 
 
-def manager_endpoint(cfg: InterProcessPortalConfig, bind: bool = False) -> str:
-    """The manager's REQ/REP endpoint."""
+def manager_endpoint(cfg: InterProcessPortalConfig) -> str:
+    """The manager's REQ/REP endpoint; the broker binds the same configured address clients connect to."""
     if cfg.transport == InterProcessPortalConfig.IPC:
         return f"ipc://{ipc_base(cfg)}.manager"
-    return tcp_endpoint("*" if bind else ip_address(cfg), cfg.tcp_port)
+    return tcp_endpoint(ip_address(cfg), cfg.tcp_port)
 
 
 def socket_endpoint(sock: Socket, cfg: InterProcessPortalConfig) -> str:

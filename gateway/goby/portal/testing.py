@@ -48,9 +48,11 @@ class BrokerProcess:
     """A ``goby-broker`` subprocess; ``start``/``stop``/``kill``/``restart`` may be called repeatedly."""
 
     def __init__(self, directory: Path, platform: str = "test", tcp: bool = False, extra_args: list[str] | None = None,
-                 startup_timeout: float = 30.0, log_path: str | os.PathLike[str] | None = None) -> None:
+                 startup_timeout: float = 30.0, log_path: str | os.PathLike[str] | None = None,
+                 address: str = "") -> None:
         self.platform = platform
         self.tcp = tcp
+        self.address = address  # TCP: the ``ip_address`` to bind and connect (empty: ipv4_address, 127.0.0.1)
         self._own_dir: str | None = None
         base = Path(directory) / f"goby_{platform}"
         if len(str(base)) > _MAX_IPC_BASE:
@@ -69,6 +71,8 @@ class BrokerProcess:
         if self.tcp:
             cfg.transport = InterProcessPortalConfig.TCP
             cfg.tcp_port = self.manager_port
+            if self.address:
+                cfg.ip_address = self.address
         else:
             cfg.socket_name = self.socket_base
         return cfg
@@ -173,13 +177,13 @@ class BrokerProcess:
 
 @contextmanager
 def broker_process(tmp_path: Path, platform: str = "test", tcp: bool = False,
-                   extra_args: list[str] | None = None, log_path: str | os.PathLike[str] | None = None
-                   ) -> Iterator[BrokerProcess]:
+                   extra_args: list[str] | None = None, log_path: str | os.PathLike[str] | None = None,
+                   address: str = "") -> Iterator[BrokerProcess]:
     """Start ``goby-broker`` on an IPC path in ``tmp_path`` (or TCP on 127.0.0.1), yield it, stop it.
 
     The broker's log goes to ``log_path`` if given (read it with ``stderr_text()``), else to this process's stderr.
     """
-    broker = BrokerProcess(tmp_path, platform, tcp, extra_args, log_path=log_path)
+    broker = BrokerProcess(tmp_path, platform, tcp, extra_args, log_path=log_path, address=address)
     with broker:
         yield broker
 
