@@ -1,0 +1,231 @@
+"""``python -m launch.trail.demo`` (``make demo``): run the trail mission headless and show what the fleet did.
+
+Starts all.launch's platforms (topside, USV, N AUVs, each a nested goby-launch with generated configs), sends the
+USV commands from the topside over the satellite link (loiter on a hexagon, then the waypoints) and RECOVER from
+the USV over the acoustic link (or lets homework 3's helm send it, ``--usv-helm goby``), records every vehicle and
+both links, then writes ``trail.png``, ``trail_tracks.csv`` and ``trail_events.csv`` into the output directory and
+prints a summary. Exit status 0 only if the mission ran and every process stopped cleanly.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import logging
+import shutil
+import signal
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from launch.errors import LaunchError, MissionConfigError
+from launch.mission import choose_program
+from launch.record import MissionRecord, shifted
+from launch.trail.analysis import command_outcomes, recover_outcome, trail_performance
+from launch.trail.links import LinkMonitor
+from launch.trail.mission import TrailMission, TrailResult, with_free_ports
+from launch.trail.operator import SCHEDULE_HELP, Operator, PortalWorker, parse_trail_schedule
+from launch.trail.plot import write_trail_png
+from launch.trail.settings import TrailSettings, Vehicle
+from launch.trail.summary import progress_line, summary_text
+from util.logsetup import add_verbosity_argument, configure_logging
+
+log = logging.getLogger(__name__)
+
+DEFAULT_AUVS = 4
+DEFAULT_WARP = 10
+DEFAULT_DURATION_S = 1500.0
+DEFAULT_SCHEDULE = {"ivp": "0:polygon:6:200,500:waypoints,1000:recover", "goby": "none"}
+MAX_SOCKET_BASE = 80  # AF_UNIX paths are limited to ~107 bytes
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, not {value}")
+    return value
+
+
+def _auvs(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if not 0 <= value <= 64:
+        raise argparse.ArgumentTypeError(f"must be 0..64, not {value}")
+    return value
+
+
+def _schedule(text: str) -> str:
+    try:
+        parse_trail_schedule(text)
+    except MissionConfigError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m launch.trail.demo", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--auvs", type=_auvs, default=DEFAULT_AUVS, help=f"number of AUVs (default {DEFAULT_AUVS})")
+    parser.add_argument("--warp", type=_positive_int, default=DEFAULT_WARP, help=f"time warp (default {DEFAULT_WARP})")
+    parser.add_argument("--duration", type=float, default=DEFAULT_DURATION_S,
+                        help=f"sim seconds after every vehicle is under command (default {DEFAULT_DURATION_S:g}; "
+                        "0 = until Ctrl-C)")
+    parser.add_argument("--usv-helm", choices=("ivp", "goby"), default="ivp",
+                        help="ivp: the MOOS helm with usv.bhv, commanded from the topside; goby: homework 3's helm "
+                        "(triangle, then RECOVER)")
+    parser.add_argument("--schedule", type=_schedule, default=None,
+                        help=f"{SCHEDULE_HELP} (default {DEFAULT_SCHEDULE['ivp']}; none with --usv-helm goby)")
+    parser.add_argument("--east-duration", type=_positive_int, default=500, help="homework helm: east leg, s")
+    parser.add_argument("--south-duration", type=_positive_int, default=200, help="homework helm: south leg, s")
+    parser.add_argument("--out", type=Path, default=Path("out"), help="output directory (default ./out)")
+    parser.add_argument("--moosdb", choices=("auto", "real", "ours"), default="auto",
+                        help="MOOSDB when on PATH (auto), force it (real) or our moos-db (ours)")
+    parser.add_argument("--helm", choices=("auto", "real", "ours"), default="auto",
+                        help="pHelmIvP when on PATH (auto), force it (real) or our ivp-helm (ours)")
+    parser.add_argument("--listen", default="127.0.0.1", metavar="ADDRESS",
+                        help="address the liaison pages listen on (default 127.0.0.1). RISK: another address lets "
+                        "anyone who can reach it watch all traffic and command the vehicles: the pages have no login")
+    add_verbosity_argument(parser)
+    return parser
+
+
+def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> TrailSettings:
+    settings = TrailSettings(
+        run_dir=run_dir,
+        warp=args.warp,
+        moosdb=choose_program(args.moosdb, "MOOSDB", "moos-db"),
+        helm=choose_program(args.helm, "pHelmIvP", "ivp-helm"),
+        usv_helm=args.usv_helm,
+        liaison_address=args.listen,
+        socket_dir=socket_dir,
+        east_duration=args.east_duration,
+        south_duration=args.south_duration,
+    )
+    return with_free_ports(settings, args.auvs, prefer_course=True)
+
+
+def write_csvs(records: dict[str, MissionRecord], operator: MissionRecord, out: Path) -> tuple[Path, Path]:
+    """trail_tracks.csv (vehicle,t,x,y,depth,heading,speed) and trail_events.csv (vehicle,t,source,name,value,origin)."""
+    tracks, events = out / "trail_tracks.csv", out / "trail_events.csv"
+    with open(tracks, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["vehicle", "t", "x", "y", "depth", "heading", "speed"])
+        for name, record in records.items():
+            for s in record.snapshot()[0]:
+                writer.writerow([name, f"{s.t:.2f}", f"{s.x:.2f}", f"{s.y:.2f}", _fmt(s.depth), _fmt(s.heading),
+                                 _fmt(s.speed)])
+    with open(events, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["vehicle", "t", "source", "name", "value", "origin"])
+        for name, record in [*records.items(), ("operator", operator)]:
+            for e in record.snapshot()[1]:
+                writer.writerow([name, f"{e.t:.2f}", e.source, e.name, e.value, e.origin])
+    return tracks, events
+
+
+def _fmt(value: float | None) -> str:
+    return "" if value is None else f"{value:.2f}"
+
+
+def report(result: TrailResult, operator: MissionRecord, n_auvs: int, links: LinkMonitor | None, sim_seconds: float,
+           out: Path, title: str) -> str:
+    """Analyse, write the CSVs and the picture, and return the summary text."""
+    records = result.records
+    operator = shifted(operator, result.t0)
+    auvs = [Vehicle("auv", n_auvs, i) for i in range(n_auvs)]
+    trails = [trail_performance(v, records[v.name], records["usv"]) for v in auvs
+              if v.name in records and "usv" in records]
+    commands = command_outcomes(operator, records)
+    recovers = [recover_outcome(v.name, records[v.name]) for v in auvs if v.name in records]
+    if not any(c.what == "recover" for c in commands) and all(r.commanded_at is None for r in recovers):
+        recovers = []  # no RECOVER in this run (homework helm not at its end, none scheduled)
+    out.mkdir(parents=True, exist_ok=True)
+    write_csvs(records, operator, out)
+    write_trail_png(out / "trail.png", records, commands, recovers, trails, title)
+    return summary_text(result, trails, commands, recovers, None if links is None else links.stats, sim_seconds,
+                        None if links is None else links.error)
+
+
+def run_demo(args: argparse.Namespace) -> int:
+    out: Path = args.out.resolve()
+    run_dir = out / "run"
+    if run_dir.exists():
+        shutil.rmtree(run_dir)
+    socket_dir = run_dir if len(str(run_dir)) < MAX_SOCKET_BASE else Path(tempfile.mkdtemp(prefix="trail-", dir="/tmp"))
+    settings = make_settings(args, run_dir, socket_dir)
+    schedule = args.schedule if args.schedule is not None else DEFAULT_SCHEDULE[args.usv_helm]
+    plan = parse_trail_schedule(schedule)
+    duration = args.duration if args.duration > 0 else None
+    n = args.auvs
+    print(f"trail mission: topside, USV ({args.usv_helm} helm) and {n} AUVs; {settings.moosdb}, {settings.helm}, "
+          f"warp {settings.warp}; MOOS ports {settings.moos_port_base}+id; logs in {run_dir / 'logs'}", flush=True)
+    print(f"schedule: {schedule}", flush=True)
+    mission = TrailMission(settings, n, report=lambda line: log.info("%s", line))
+    links = LinkMonitor(settings, n)
+    mission.add_hook(links.poll)
+    operator_record = MissionRecord()
+    workers: list[PortalWorker] = []
+    previous = {s: signal.signal(s, lambda *_: mission.stop_event.set()) for s in (signal.SIGINT, signal.SIGTERM)}
+    failure = None
+    started = time.monotonic()
+    sim_seconds = 0.0
+    try:
+        print(f"starting {len(mission.entries)} platforms ...", flush=True)
+        mission.start()
+        topside = PortalWorker("topside", Vehicle("topside", n).ipc_base(settings), settings.warp)
+        usv = PortalWorker("usv", Vehicle("usv", n).ipc_base(settings), settings.warp) if args.usv_helm == "ivp" else None
+        workers = [w for w in (topside, usv) if w is not None]
+        for worker in workers:
+            worker.start()
+        operator = Operator(plan, operator_record, mission.clock, topside, usv)
+        mission.add_hook(operator.poll)
+        print(f"all platforms up after {time.monotonic() - started:.0f} s; waiting for every vehicle to reach "
+              "COMMAND ...", flush=True)
+        t0 = mission.wait_for_command(progress=lambda: print(progress_line(
+            {k: r.record for k, r in mission.runs.items()}, 0, None), flush=True))
+        if t0 is not None:
+            print(f"every vehicle under helm command ({time.monotonic() - started:.0f} s real)", flush=True)
+            operator.start(t0)
+            mission.run(duration, lambda t: print(progress_line({k: r.record for k, r in mission.runs.items()}, t,
+                                                                duration), flush=True))
+            sim_seconds = mission.now() - t0
+    except LaunchError as exc:
+        failure = str(exc)
+        print(f"demo: {exc}", file=sys.stderr, flush=True)
+    finally:
+        for worker in workers:
+            worker.close()
+        links.poll()
+        links.close()
+        result = mission.stop(failure)
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        if socket_dir != run_dir:
+            shutil.rmtree(socket_dir, ignore_errors=True)
+    title = (f"Trail mission: USV ({args.usv_helm} helm) + {n} AUVs, {settings.helm} + {settings.moosdb}, "
+             f"warp {settings.warp}, {sim_seconds:.0f} sim s")
+    print(report(result, operator_record, n, links, sim_seconds, out, title), flush=True)
+    real = time.monotonic() - started
+    print(f"wrote {out / 'trail.png'}, {out / 'trail_tracks.csv'} and {out / 'trail_events.csv'} "
+          f"({real:.0f} s real time)")
+    clean = all(o.clean for o in result.outcomes)
+    return 0 if failure is None and clean else 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    configure_logging(args.verbose, "trail-demo")
+    try:
+        return run_demo(args)
+    except LaunchError as exc:
+        print(f"demo: {exc}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,111 @@
+"""The trail demo's printed summary and progress lines."""
+
+from __future__ import annotations
+
+import statistics
+
+from launch.record import MissionRecord
+from launch.trail.analysis import (
+    CommandOutcome,
+    RecoverOutcome,
+    TrailPerformance,
+    distance_travelled,
+    state_timeline,
+)
+from launch.trail.links import LinkStats
+from launch.trail.mission import TrailResult
+
+
+def _latest(record: MissionRecord, name: str, source: str = "moos") -> str:
+    events = record.events_named(name, source)
+    return events[-1].value.removeprefix("INTERFACE_") if events else "?"
+
+
+def progress_line(records: dict[str, MissionRecord], elapsed: float, duration: float | None) -> str:
+    """One line while the mission runs: sim time, then per vehicle its interface state, position and depth."""
+    parts = []
+    for name, record in records.items():
+        if name == "topside":
+            continue
+        nav = record.snapshot()[0]
+        state = _latest(record, "interface_state", "interface")
+        where = f"({nav[-1].x:.0f},{nav[-1].y:.0f})" if nav else "(no nav)"
+        depth = f" {nav[-1].depth:.0f}m" if nav and nav[-1].depth else ""
+        parts.append(f"{name} {state[:4]} {where}{depth}")
+    total = f"/{duration:.0f}" if duration else ""
+    return f"t={elapsed:6.0f}{total} s | " + " | ".join(parts)
+
+
+def _timeline(items: list[tuple[float, str, str]], what: str) -> str:
+    picked = [(t, v) for t, w, v in items if w == what]
+    return " -> ".join(f"{v} ({t:.0f})" for t, v in picked) or "-"
+
+
+def summary_text(result: TrailResult, trails: list[TrailPerformance], commands: list[CommandOutcome],
+                 recovers: list[RecoverOutcome], links: dict[str, LinkStats] | None, sim_seconds: float,
+                 link_error: str | None = None) -> str:
+    lines = ["", "=== Trail mission summary (sim seconds; t=0 when every vehicle was under helm command) ==="]
+    lines.append("vehicles (state changes with their times; distance travelled):")
+    for name, record in result.records.items():
+        if name == "topside":
+            continue
+        timeline = state_timeline(record)
+        nav = record.snapshot()[0]
+        deploy = "DEPLOY_STATE" if name == "usv" else "AUV_DEPLOY_STATE"
+        lines.append(f"  {name}: interface {_timeline(timeline, 'interface')}; helm {_timeline(timeline, 'IVPHELM_STATE')}; "
+                     f"{deploy} {_timeline(timeline, deploy)}; {distance_travelled(nav):.0f} m over {len(nav)} fixes")
+    if trails:
+        lines.append("trail (range 50 m at each AUV's angle; errors from the first fix within 20 m of the trail point "
+                     "until RECOVER or the end):")
+    for trail in trails:
+        if trail.settled_at is None:
+            lines.append(f"  {trail.name} (angle {trail.trail_angle:g}, depth {trail.depth:g} m): never within 20 m "
+                         "of its trail point")
+            continue
+        lines.append(f"  {trail.name} (angle {trail.trail_angle:g}, depth {trail.depth:g} m): trailing from "
+                     f"t={trail.settled_at:.0f} s; range error {trail.range_error} m; angle error {trail.angle_error} "
+                     f"deg; depth error {trail.depth_error} m")
+    lines.append("commands (sent from the topside over satellite / RECOVER from the USV over acomms):")
+    for n, command in enumerate(commands, start=1):
+        ack = f"acked t={command.acked_at:.0f}" if command.acked_at is not None else (
+            f"EXPIRED ({command.expired})" if command.expired else "not acked")
+        arrived = ", ".join(f"{v} t={t:.0f} (+{t - command.sent_at:.0f} s)" for v, t in command.arrived_at.items())
+        lines.append(f"  {n}. {command.what}: sent t={command.sent_at:.0f}, {ack}; in MOOS: {arrived or 'never'}")
+    latencies = [x for c in commands for x in c.latencies]
+    if latencies:
+        lines.append(f"  command latency sender -> MOOS: mean {statistics.fmean(latencies):.1f} s, max "
+                     f"{max(latencies):.1f} s over {len(latencies)} arrivals")
+    if not commands:
+        lines.append("  (none sent)")
+    if recovers:
+        lines.append("RECOVER (station 100,-100):")
+    for r in recovers:
+        if r.commanded_at is None:
+            lines.append(f"  {r.name}: RECOVER never reached its MOOSDB")
+            continue
+        lines.append(f"  {r.name}: AUV_DEPLOY_STATE=RECOVER t={r.commanded_at:.0f} "
+                     f"({'after' if r.depth_updates_first else 'WITHOUT'} DEPLOY_DEPTH_UPDATES=depth=0); final depth "
+                     f"{r.final_depth:.1f} m, distance to station {r.final_distance_to_station:.0f} m "
+                     f"(closest {r.min_distance_to_station:.0f} m)")
+    if links is not None:
+        lines.append(f"links (every datagram on the multicast groups, {sim_seconds:.0f} sim s):")
+        for stats in links.values():
+            saturation = stats.saturation(sim_seconds)
+            sat = "-" if saturation is None else f"{100 * saturation:.0f}% of slot capacity"
+            senders = ", ".join(f"{src}: {n}" for src, n in sorted(stats.by_src.items()))
+            lines.append(f"  {stats.name}: {stats.data_transmissions} data transmissions ({senders or 'none'}), "
+                         f"{stats.frames} frames, {stats.frame_bytes} bytes, {stats.acks} acks; {sat}")
+    if link_error:
+        lines.append(f"  link statistics incomplete: {link_error}")
+    clean = [o for o in result.outcomes if o.clean]
+    lines.append(f"launchers: {len(clean)}/{len(result.outcomes)} exited cleanly"
+                 + "".join(f"\n  NOT clean: {o.name} (exit status {o.returncode}, log {o.log_path})"
+                           for o in result.outcomes if not o.clean))
+    if result.log_errors:
+        lines.append(f"unexpected error lines in the logs ({len(result.log_errors)}):")
+        lines.extend(f"  {line}" for line in result.log_errors[:20])
+    else:
+        lines.append("logs: no unexpected errors")
+    if result.failure:
+        lines.append(f"FAILED: {result.failure}")
+    return "\n".join(lines)
