@@ -17,6 +17,7 @@ import signal
 import sys
 import tempfile
 import time
+from collections import Counter
 from pathlib import Path
 
 from launch.errors import LaunchError, MissionConfigError
@@ -147,8 +148,9 @@ def report(result: TrailResult, operator: MissionRecord, n_auvs: int, links: Lin
     out.mkdir(parents=True, exist_ok=True)
     write_csvs(records, operator, out)
     write_trail_png(out / "trail.png", records, commands, recovers, trails, title)
+    view = Counter(e.value for e in operator.events_named("node_status", "topside"))
     return summary_text(result, trails, commands, recovers, None if links is None else links.stats, sim_seconds,
-                        None if links is None else links.error)
+                        None if links is None else links.error, dict(view))
 
 
 def run_demo(args: argparse.Namespace) -> int:
@@ -182,6 +184,7 @@ def run_demo(args: argparse.Namespace) -> int:
         workers = [w for w in (topside, usv) if w is not None]
         for worker in workers:
             worker.start()
+        topside.watch_node_status(operator_record, mission.clock)
         operator = Operator(plan, operator_record, mission.clock, topside, usv)
         mission.add_hook(operator.poll)
         print(f"all platforms up after {time.monotonic() - started:.0f} s; waiting for every vehicle to reach "

@@ -43,8 +43,11 @@ def _timeline(items: list[tuple[float, str, str]], what: str) -> str:
 
 def summary_text(result: TrailResult, trails: list[TrailPerformance], commands: list[CommandOutcome],
                  recovers: list[RecoverOutcome], links: dict[str, LinkStats] | None, sim_seconds: float,
-                 link_error: str | None = None) -> str:
+                 link_error: str | None = None, topside_view: dict[str, int] | None = None) -> str:
     lines = ["", "=== Trail mission summary (sim seconds; t=0 when every vehicle was under helm command) ==="]
+    if topside_view is not None:
+        seen = ", ".join(f"{name} x{count}" for name, count in sorted(topside_view.items())) or "nothing"
+        lines.append(f"topside NodeStatus (the topside manager's republished nav, over satellite): {seen}")
     lines.append("vehicles (state changes with their times; distance travelled):")
     for name, record in result.records.items():
         if name == "topside":

@@ -1,0 +1,138 @@
+"""Fleet scale: the trail mission with 0, 4, 8 and 16 AUVs at warp 5, as ``all.launch`` runs it.
+
+``python -m bench.bench_fleet [--sizes 0,4,8,16] [--warp 5] [--sim 200]``. Per size it starts the whole mission
+(topside, USV, N AUVs: every process of every platform), waits until every vehicle is under helm command, then
+measures over ``--sim`` simulated seconds:
+
+- CPU seconds (user+system, every process of the mission) per simulated second, and the share of the machine's cores
+  that is (above ~90 % the mission cannot keep up);
+- RSS per vehicle (every process of a platform summed; the topside counts as a vehicle);
+- kept up? NAV fixes that reached each vehicle's MOOSDB per simulated second (the simulator sends one per simulated
+  second, so 1.00 means the whole frontseat -> interface -> MOOS chain kept pace with the warp), worst vehicle;
+- link saturation: bytes carried over what the slot plan could carry (satellite, acomms), from the multicast groups.
+
+Start-up time (launch to every vehicle under command) is printed too: it is what grows fastest with the fleet.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from launch.errors import LaunchError
+from launch.trail.links import LinkMonitor
+from launch.trail.mission import TrailMission, with_free_ports
+from launch.trail.settings import TrailSettings
+
+CLK_TCK = os.sysconf("SC_CLK_TCK")
+PAGE = os.sysconf("SC_PAGE_SIZE")
+
+
+def _children() -> dict[int, list[int]]:
+    tree: dict[int, list[int]] = {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            stat = Path(f"/proc/{entry}/stat").read_text()
+        except OSError:
+            continue
+        ppid = int(stat.rsplit(")", 1)[1].split()[1])
+        tree.setdefault(ppid, []).append(int(entry))
+    return tree
+
+
+def _subtree(root: int, tree: dict[int, list[int]]) -> list[int]:
+    out, todo = [], [root]
+    while todo:
+        pid = todo.pop()
+        out.append(pid)
+        todo.extend(tree.get(pid, []))
+    return out
+
+
+def _cpu_and_rss(pids: list[int]) -> tuple[float, int]:
+    cpu, rss = 0.0, 0
+    for pid in pids:
+        try:
+            fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+            rss += int(Path(f"/proc/{pid}/statm").read_text().split()[1]) * PAGE
+        except (OSError, IndexError):
+            continue
+        cpu += (int(fields[11]) + int(fields[12])) / CLK_TCK  # utime, stime
+    return cpu, rss
+
+
+def measure(n_auvs: int, warp: int, sim_seconds: float) -> dict[str, object]:
+    run_dir = Path(tempfile.mkdtemp(prefix=f"fleet{n_auvs}-", dir="/tmp"))
+    settings = with_free_ports(TrailSettings(run_dir=run_dir, warp=warp), n_auvs, prefer_course=False)
+    mission = TrailMission(settings, n_auvs, report=lambda line: None, launch_delay_s=1.0)
+    links = LinkMonitor(settings, n_auvs)
+    mission.add_hook(links.poll)
+    row: dict[str, object] = {"auvs": n_auvs}
+    started = time.monotonic()
+    try:
+        mission.start()
+        mission.wait_for_command(timeout_s=600)
+        row["startup_s"] = time.monotonic() - started
+        assert mission.group is not None
+        roots = {p.name: p.pid for p in mission.group.processes}
+        tree = _children()
+        cpu0 = sum(_cpu_and_rss(_subtree(pid, tree))[0] for pid in roots.values())
+        nav0 = {name: len(run.record.snapshot()[0]) for name, run in mission.runs.items()}
+        real0, sim0 = time.monotonic(), mission.now()
+        mission.run(None, until=lambda: mission.now() - sim0 >= sim_seconds)
+        real, sim = time.monotonic() - real0, mission.now() - sim0
+        tree = _children()
+        per_platform = {name: _cpu_and_rss(_subtree(pid, tree)) for name, pid in roots.items()}
+        cpu = sum(c for c, _ in per_platform.values()) - cpu0
+        row["cpu_per_sim_s"] = cpu / sim
+        row["core_share"] = cpu / real / (os.cpu_count() or 1)
+        row["rss_mb_per_vehicle"] = sum(r for _, r in per_platform.values()) / len(per_platform) / 2**20
+        rates = [(len(run.record.snapshot()[0]) - nav0[name]) / sim for name, run in mission.runs.items()
+                 if run.vehicle.kind != "topside"]
+        row["nav_per_sim_s_min"] = min(rates) if rates else float("nan")
+        row["kept_up"] = bool(rates) and min(rates) > 0.9
+        row["sat_satellite"] = links.stats["satellite"].saturation(sim)
+        row["sat_acomms"] = links.stats["acomms"].saturation(sim)
+    except LaunchError as exc:
+        row["error"] = str(exc).splitlines()[0]
+    finally:
+        links.close()
+        mission.stop()
+    return row
+
+
+def _pct(value: object) -> str:
+    return "-" if value is None else f"{100 * float(value):.0f}%"  # type: ignore[arg-type]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m bench.bench_fleet", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--sizes", default="0,4,8,16", help="AUV counts (default 0,4,8,16)")
+    parser.add_argument("--warp", type=int, default=5, help="time warp (default 5, the course's)")
+    parser.add_argument("--sim", type=float, default=200.0, help="simulated seconds measured per size (default 200)")
+    args = parser.parse_args(argv)
+    sizes = [int(s) for s in args.sizes.split(",")]
+    print(f"trail mission fleet scale, warp {args.warp}, {args.sim:g} sim s per size, {os.cpu_count()} cores")
+    header = (f"{'AUVs':>4} {'start-up s':>10} {'CPU s/sim s':>11} {'cores used':>10} {'RSS MB/veh':>10} "
+              f"{'NAV/sim s':>9} {'kept up':>7} {'sat. link':>9} {'acomms':>7}")
+    print(header)
+    for n in sizes:
+        row = measure(n, args.warp, args.sim)
+        if "error" in row:
+            print(f"{n:>4} failed: {row['error']}", flush=True)
+            continue
+        print(f"{n:>4} {row['startup_s']:>10.0f} {row['cpu_per_sim_s']:>11.2f} {_pct(row['core_share']):>10} "
+              f"{row['rss_mb_per_vehicle']:>10.0f} {row['nav_per_sim_s_min']:>9.2f} "
+              f"{'yes' if row['kept_up'] else 'NO':>7} {_pct(row['sat_satellite']):>9} {_pct(row['sat_acomms']):>7}",
+              flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,92 @@
+"""The whole trail mission, as ``./all.launch`` runs it, reduced for CI: topside, USV and 2 AUVs at warp 20.
+
+Every process is real (one goby-launch per platform, brokers with the satellite and acomms links on UDP multicast,
+frontseat simulators and interfaces, moos-db, ivp-helm, node-reporter, gateways, managers, liaison pages). The
+demo's operator sends POLYGON then WAYPOINTS from the topside over the satellite link and RECOVER from the USV over
+the acoustic link. Asserted from the recorded run, the course_and_peers §1.10 checklist items that apply:
+every vehicle reaches COMMAND; the topside republishes every vehicle's nav as NodeStatus; the USV obeys both
+commands (POLYGON_UPDATES before DEPLOY_STATE) and every command is acked; the AUVs trail at their angle and depth;
+RECOVER reaches every AUV (depth=0 first), which surfaces and heads for the station; every process exits cleanly
+with no error line in any log.
+"""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+
+from launch.record import MissionRecord, shifted
+from launch.trail.analysis import command_outcomes, recover_outcome, trail_performance
+from launch.trail.links import LinkMonitor
+from launch.trail.mission import TrailMission, with_free_ports
+from launch.trail.operator import Operator, PortalWorker, parse_trail_schedule
+from launch.trail.settings import TrailSettings, Vehicle
+
+N_AUVS = 2
+WARP = 20
+SCHEDULE = "0:polygon:6:200,200:waypoints,350:recover"
+DURATION = 550.0
+NEEDED = ("auv-manager", "topside-manager", "usv-manager")
+
+pytestmark = pytest.mark.skipif(any(shutil.which(p) is None for p in NEEDED),
+                                reason=f"the course's managers ({', '.join(NEEDED)}) are not installed yet")
+
+
+def test_trail_mission_two_auvs(tmp_path):
+    settings = with_free_ports(TrailSettings(run_dir=tmp_path, warp=WARP, socket_dir=tmp_path), N_AUVS,
+                               prefer_course=False)
+    mission = TrailMission(settings, N_AUVS, report=lambda line: None, launch_delay_s=0.5)
+    links = LinkMonitor(settings, N_AUVS)
+    mission.add_hook(links.poll)
+
+    operator_record = MissionRecord()
+    workers: list[PortalWorker] = []
+    try:
+        mission.start()
+        topside = PortalWorker("topside", Vehicle("topside", N_AUVS).ipc_base(settings), WARP)
+        usv = PortalWorker("usv", Vehicle("usv", N_AUVS).ipc_base(settings), WARP)
+        workers = [topside, usv]
+        for worker in workers:
+            worker.start()
+        topside.watch_node_status(operator_record, mission.clock)
+        operator = Operator(parse_trail_schedule(SCHEDULE), operator_record, mission.clock, topside, usv)
+        mission.add_hook(operator.poll)
+        t0 = mission.wait_for_command(timeout_s=120)
+        assert t0 is not None
+        operator.start(t0)
+        mission.run(DURATION)
+    finally:
+        for worker in workers:
+            worker.close()
+        links.close()
+        result = mission.stop()
+
+    records = result.records
+    assert all(t is not None for t in result.command_times.values()), result.command_times
+    operator_events = shifted(operator_record, result.t0)
+    seen = {e.value for e in operator_events.events_named("node_status", "topside")}
+    assert {"USV", "AUV_0", "AUV_1"} <= seen, seen
+
+    commands = command_outcomes(operator_events, records)
+    assert [c.what.split()[0] for c in commands] == ["polygon", "waypoints", "recover"], commands
+    assert all(c.acked_at is not None for c in commands), commands
+    assert "usv" in commands[0].arrived_at and "usv" in commands[1].arrived_at, commands
+    usv_posts = [e.name for e in records["usv"].snapshot()[1]
+                 if e.name in ("POLYGON_UPDATES", "DEPLOY_STATE") and e.t >= commands[0].sent_at]
+    assert usv_posts[:2] == ["POLYGON_UPDATES", "DEPLOY_STATE"], usv_posts
+    assert set(commands[2].arrived_at) == {"auv0", "auv1"}, commands[2]
+
+    for i in range(N_AUVS):
+        vehicle = Vehicle("auv", N_AUVS, i)
+        trail = trail_performance(vehicle, records[vehicle.name], records["usv"])
+        assert trail.settled_at is not None, f"{vehicle.name} never came within 20 m of its trail point"
+        assert trail.range_error is not None and trail.range_error.mean < 25, trail.range_error
+        assert trail.depth_error is not None and trail.depth_error.mean < 3, trail.depth_error
+        recover = recover_outcome(vehicle.name, records[vehicle.name])
+        assert recover.depth_updates_first, recover
+        assert recover.final_depth is not None and recover.final_depth < 3, recover
+        assert recover.min_distance_to_station is not None
+    assert links.stats["satellite"].acks > 0 and links.stats["acomms"].frames > 0
+    assert all(o.clean for o in result.outcomes), result.outcomes
+    assert not result.log_errors, result.log_errors[:10]
