@@ -31,7 +31,7 @@ log = logging.getLogger(__name__)
 FIRST_PARTY = ("gateway", "translators", "frontseat", "behaviors", "launch")
 # The transport itself publishes on internal groups (manager handshake and the like); Goby never lists those.
 EXCLUDED_PACKAGES = ("gateway.goby.portal", "launch.interfaces", "gateway.moos")
-LAYER_METHODS = {"interprocess": "interprocess", "interthread": "interthread"}
+LAYER_METHODS = {"interprocess": "interprocess", "interthread": "interthread", "intervehicle": "intervehicle"}
 
 
 class AnalysisError(LaunchError):
@@ -61,7 +61,7 @@ def _scheme_for(message_type: type) -> str:
 
 
 def _layer_of(node: ast.expr, aliases: dict[str, str]) -> str | None:
-    """The portal layer an expression denotes: a chain ending in ``interprocess()``/``interthread()``."""
+    """The portal layer an expression denotes: a chain ending in ``interprocess()``/``interthread()``/``intervehicle()``."""
     if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in LAYER_METHODS:
         return LAYER_METHODS[node.func.attr]
     if isinstance(node, ast.Name):
@@ -314,7 +314,8 @@ class _ModuleAnalyzer(ast.NodeVisitor):
                 raise AnalysisError(f"{self._where(node)}: subscribe call without a message type")
             message_type = self._as_type(self._eval(type_expr, node, "message type"), type_expr, node)
             direction = "subscribes"
-        scheme = "CXX_OBJECT" if layer == "interthread" else _scheme_for(message_type)
+        # intervehicle carries DCCL only (Goby's InterVehicleForwarder/Portal are DCCL-only transporters)
+        scheme = {"interthread": "CXX_OBJECT", "intervehicle": "DCCL"}.get(layer) or _scheme_for(message_type)
         self.interface.add(PubSubEntry(layer, thread, group, scheme, cxx_type_name(message_type), direction))
 
     def _note_thread(self, thread: str) -> None:

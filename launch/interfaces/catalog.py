@@ -20,6 +20,7 @@ SHIPPED_APPLICATIONS: dict[str, list[str]] = {
     "goby-helm-example": ["behaviors.apps.goby_helm_example"],
     "usv-mission-shore": ["launch.usv.shore"],
     "usv-mission-recorder": ["launch.recorder"],
+    "trail-mission-operator": ["launch.trail.operator"],
 }
 
 

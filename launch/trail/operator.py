@@ -31,7 +31,7 @@ from launch.record import MissionRecord
 from launch.recorder import SimClock
 from launch.usv.shore import NO_SCHEDULE, ScheduledCommand, parse_schedule
 from translators.trail import groups
-from translators.usv.protobuf.command_dccl_pb2 import AUVCommand
+from translators.usv.protobuf.command_dccl_pb2 import AUVCommand, USVCommand
 from translators.usv.validation import check_dccl_bounds
 
 log = logging.getLogger(__name__)
@@ -171,7 +171,8 @@ class Operator:
 
     def _send_usv_command(self, thread: SimpleThread, planned: PlannedCommand) -> None:
         assert planned.usv is not None
-        message = check_dccl_bounds(planned.usv.to_message(thread.context.clock.now()), codec=thread.context.dccl)
+        message: USVCommand = check_dccl_bounds(planned.usv.to_message(thread.context.clock.now()),
+                                                codec=thread.context.dccl)
         label = planned.describe()
         thread.intervehicle().publish(groups.usv_command, message, publisher=Publisher(
             on_ack=lambda _msg, ack: self._event("ack", label, _ack_origin(ack)),
