@@ -91,6 +91,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--listen", default="127.0.0.1", metavar="ADDRESS",
                         help="address the liaison pages listen on (default 127.0.0.1). RISK: another address lets "
                         "anyone who can reach it watch all traffic and command the vehicles: the pages have no login")
+    parser.add_argument("--keep-going", action="store_true",
+                        help="when a platform's process dies (its goby-launch then stops that platform), keep the "
+                        "other platforms running; the summary says what died when (default: stop everything)")
     add_verbosity_argument(parser)
     return parser
 
@@ -153,6 +156,14 @@ def report(result: TrailResult, operator: MissionRecord, n_auvs: int, links: Lin
                         None if links is None else links.error, dict(view))
 
 
+def _report(line: str) -> None:
+    """The launcher's lines: deaths always, the rest with -v."""
+    if "died" in line:
+        print(line, flush=True)
+    else:
+        log.info("%s", line)
+
+
 def run_demo(args: argparse.Namespace) -> int:
     out: Path = args.out.resolve()
     run_dir = out / "run"
@@ -167,7 +178,7 @@ def run_demo(args: argparse.Namespace) -> int:
     print(f"trail mission: topside, USV ({args.usv_helm} helm) and {n} AUVs; {settings.moosdb}, {settings.helm}, "
           f"warp {settings.warp}; MOOS ports {settings.moos_port_base}+id; logs in {run_dir / 'logs'}", flush=True)
     print(f"schedule: {schedule}", flush=True)
-    mission = TrailMission(settings, n, report=lambda line: log.info("%s", line))
+    mission = TrailMission(settings, n, report=_report, keep_going=args.keep_going)
     links = LinkMonitor(settings, n)
     mission.add_hook(links.poll)
     operator_record = MissionRecord()
@@ -217,7 +228,7 @@ def run_demo(args: argparse.Namespace) -> int:
     print(f"wrote {out / 'trail.png'}, {out / 'trail_tracks.csv'} and {out / 'trail_events.csv'} "
           f"({real:.0f} s real time)")
     clean = all(o.clean for o in result.outcomes)
-    return 0 if failure is None and clean else 1
+    return 0 if failure is None and clean and not result.deaths else 1
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -75,7 +75,7 @@ class TrailResult:
     outcomes: list[ProcessOutcome] = field(default_factory=list)
     log_errors: list[str] = field(default_factory=list)
     failure: str | None = None
-    extra: dict[str, object] = field(default_factory=dict)
+    deaths: list[tuple[float, str, str]] = field(default_factory=list)  # (t, launcher, log tail) with keep_going
 
 
 class TrailMission:
@@ -96,6 +96,7 @@ class TrailMission:
         report: Callable[[str], None] = print,
         launch_delay_s: float = 1.0,
         platform: str = "trail",
+        keep_going: bool = False,
     ) -> None:
         self.settings = settings
         self.n_auvs = n_auvs
@@ -104,6 +105,10 @@ class TrailMission:
         self.report = report
         self.launch_delay_s = launch_delay_s
         self.platform = platform
+        # keep_going: a platform whose launcher dies (it stops its own processes first) is noted in ``deaths`` and
+        # the other platforms run on; otherwise the first death ends the run.
+        self.keep_going = keep_going
+        self.deaths: list[tuple[float, str, str]] = []  # (sim time, launcher, last lines of its log)
         self.clock = SimClock(settings.warp)
         self.runs = {v.name: VehicleRun(v) for v in (vehicles if vehicles is not None else fleet(n_auvs))}
         self.group: ProcessGroup | None = None
@@ -169,8 +174,12 @@ class TrailMission:
             hook()
         assert self.group is not None
         died = self.group.check()
-        if died is not None:
-            raise ProcessDiedError(died.name, died.returncode, died.log_tail(40))
+        while died is not None:
+            if not self.keep_going:
+                raise ProcessDiedError(died.name, died.returncode, died.log_tail(40))
+            self.deaths.append((self.now(), died.name, died.log_tail(40)))
+            self.report(f"{died.name} died (exit status {died.returncode}); the other platforms keep running")
+            died = self.group.check()
         for run in self.runs.values():
             if run.portal is not None and run.portal.error is not None:
                 raise LaunchError(f"the portal recorder of {run.vehicle.name} failed: {run.portal.error}")
@@ -179,7 +188,9 @@ class TrailMission:
         return self.clock.now()
 
     def missing_command(self) -> list[str]:
-        return [name for name, run in self.runs.items() if run.vehicle.kind != "topside" and run.command_time() is None]
+        dead = {name for _, name, _ in self.deaths}
+        return [name for name, run in self.runs.items()
+                if run.vehicle.kind != "topside" and run.command_time() is None and name not in dead]
 
     def wait_for_command(self, timeout_s: float = 180.0, progress: Callable[[], None] | None = None) -> float | None:
         """Block until every recorded vehicle's frontseat interface reports COMMAND; returns that sim time."""
@@ -249,6 +260,7 @@ class TrailMission:
             outcomes=ended,
             log_errors=errors,
             failure=failure,
+            deaths=[(t - t0, name, tail) for t, name, tail in self.deaths],
         )
         return self._result
 

@@ -42,9 +42,9 @@ def write_trail_png(path: Path, records: dict[str, MissionRecord], commands: lis
         ax.plot([s.x for s in nav], [s.y for s in nav], label=name.upper() if name == "usv" else name, **style)
         ax.plot(nav[0].x, nav[0].y, marker="s", color=style["color"], markersize=4, linestyle="none")
     for n, command in enumerate(commands, start=1):
-        if command.what == "recover" or "usv" not in records:
+        if command.what == "recover" or "usv" not in records or "usv" not in command.arrived_at:
             continue
-        t = command.arrived_at.get("usv", command.sent_at)
+        t = command.arrived_at["usv"]
         where = _at(records["usv"], t)
         if where is None:
             continue

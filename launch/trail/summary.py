@@ -38,7 +38,7 @@ def progress_line(records: dict[str, MissionRecord], elapsed: float, duration: f
 
 def _timeline(items: list[tuple[float, str, str]], what: str) -> str:
     picked = [(t, v) for t, w, v in items if w == what]
-    return " -> ".join(f"{v} ({t:.0f})" for t, v in picked) or "-"
+    return " -> ".join(f"{v} ({round(t):d})" for t, v in picked) or "-"
 
 
 def summary_text(result: TrailResult, trails: list[TrailPerformance], commands: list[CommandOutcome],
@@ -100,6 +100,8 @@ def summary_text(result: TrailResult, trails: list[TrailPerformance], commands: 
                          f"{stats.frames} frames, {stats.frame_bytes} bytes, {stats.acks} acks; {sat}")
     if link_error:
         lines.append(f"  link statistics incomplete: {link_error}")
+    for t, name, tail in result.deaths:
+        lines.append(f"DIED at t={t:.0f} s: {name} (the others kept running); last lines of its log:\n{tail}")
     clean = [o for o in result.outcomes if o.clean]
     lines.append(f"launchers: {len(clean)}/{len(result.outcomes)} exited cleanly"
                  + "".join(f"\n  NOT clean: {o.name} (exit status {o.returncode}, log {o.log_path})"
