@@ -115,15 +115,23 @@ def parse_start(fields: dict[str, str]) -> StartParams:
     )
 
 
+# What a CMD may ask (the vehicle model has no other limits): heading in degrees either way round, speed
+# forward only and below any real vessel's, depth from the surface to the deepest ocean.
+COMMAND_RANGES = {"HEADING": (-360.0, 360.0), "SPEED": (0.0, 100.0), "DEPTH": (0.0, 11_000.0)}
+
+
 def parse_command(fields: dict[str, str]) -> tuple[float, float, float]:
-    """CMD fields -> (heading, speed, depth). Raises :class:`SimulatorLineError` for a missing or non-numeric value."""
+    """CMD fields -> (heading, speed, depth). Raises :class:`SimulatorLineError` for a missing, non-numeric,
+    non-finite or out-of-range value (see ``COMMAND_RANGES``)."""
     values = []
-    for name in ("HEADING", "SPEED", "DEPTH"):
+    for name, (low, high) in COMMAND_RANGES.items():
         if name not in fields:
             raise SimulatorLineError(f"Invalid CMD: missing {name} field")
         value = protocol.as_double(fields[name])
         if not math.isfinite(value):
             raise SimulatorLineError(f"Invalid CMD: {name} {fields[name]!r} is not a finite number")
+        if not low <= value <= high:
+            raise SimulatorLineError(f"Invalid CMD: {name} {fields[name]!r} is outside {low:g}..{high:g}")
         values.append(value)
     return values[0], values[1], values[2]
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import math
 import signal
 import sys
 from pathlib import Path
@@ -17,6 +18,7 @@ from pathlib import Path
 from gateway.moos.errors import MissionFileError
 from gateway.moos.mission_file import MissionFile
 from gateway.moos.server import MoosDB
+from util.cli import bounded_number, positive_number
 from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
@@ -46,18 +48,21 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("mission_file", nargs="?", help="mission file (.moos) for ServerPort, Community, "
                         "MOOSTimeWarp and ClientTimeout (default Mission.moos if present)")
     parser.add_argument("--moos_file", help="mission file (same as the positional argument)")
-    parser.add_argument("--moos_port", type=int, help="port to listen on (default ServerPort or 9000; 0 = any free)")
+    parser.add_argument("--moos_port", type=bounded_number(int, 0, 65535),
+                        help="port to listen on (default ServerPort or 9000; 0 = any free)")
     parser.add_argument("--moos_community", help="community name (default Community or #1)")
-    parser.add_argument("--moos_time_warp", type=float, help="time warp (default MOOSTimeWarp or 1)")
-    parser.add_argument("--moos_timeout", type=float, help="seconds of client silence before disconnect (default 5)")
+    parser.add_argument("--moos_time_warp", type=positive_number,
+                        help="time warp (default MOOSTimeWarp or 1)")
+    parser.add_argument("--moos_timeout", type=positive_number,
+                        help="seconds of client silence before disconnect (default 5)")
     parser.add_argument("--moos_address", default="127.0.0.1",
                         help="address to bind (default 127.0.0.1; 0.0.0.0 for every interface like the C++ DB)")
-    parser.add_argument("--max_packet_bytes", type=int, default=64 * 1024 * 1024,
+    parser.add_argument("--max_packet_bytes", type=bounded_number(int, 1), default=64 * 1024 * 1024,
                         help="largest packet accepted from a client before it is dropped (also the most "
                         "unfinished input one connection may buffer)")
-    parser.add_argument("--max_outbox_bytes", type=int, default=16 * 1024 * 1024,
+    parser.add_argument("--max_outbox_bytes", type=bounded_number(int, 1), default=16 * 1024 * 1024,
                         help="unsent bytes one client may have queued before it is dropped as too slow")
-    parser.add_argument("--max_buffered_bytes", type=int, default=256 * 1024 * 1024,
+    parser.add_argument("--max_buffered_bytes", type=bounded_number(int, 1), default=256 * 1024 * 1024,
                         help="input and output buffered for all connections together; past it the connection "
                         "holding the most is dropped")
     parser.add_argument("--response", default="",
@@ -87,20 +92,19 @@ def main(argv: list[str] | None = None) -> int:
     if path is None and Path("Mission.moos").exists():
         path = "Mission.moos"
     if path is not None:
-        try:
+        try:  # a DB on the wrong port or warp serves nobody: a bad mission file is fatal (exit 2), not a warning
             mission = MissionFile(path)
+            mission.check()
             port, community, warp = mission.server_port, mission.community, mission.time_warp
-            client_timeout = mission.global_value("ClientTimeout")
-            if client_timeout:
-                timeout = float(client_timeout)
-        except (MissionFileError, ValueError) as exc:
-            if args.moos_file or args.mission_file:
-                log.warning("mission file not used: %s", exc)
+            timeout = mission.global_number("ClientTimeout", 0, math.inf, low_inclusive=False) or timeout
+        except MissionFileError as exc:
+            log.error("mission file not usable: %s", exc)
+            return 2
     if args.moos_port is not None:
         port = args.moos_port
     if args.moos_community:
         community = args.moos_community
-    if args.moos_time_warp is not None and args.moos_time_warp > 0:
+    if args.moos_time_warp is not None:
         warp = args.moos_time_warp
     if args.moos_timeout is not None:
         timeout = args.moos_timeout

@@ -9,6 +9,7 @@ with their internal spaces kept.
 from __future__ import annotations
 
 import logging
+import math
 import os
 import re
 from pathlib import Path
@@ -46,20 +47,21 @@ class MissionFile:
             text = self.path.read_text(encoding="utf-8", errors="surrogateescape")
         except OSError as exc:
             raise MissionFileError(f"cannot read mission file {self.path}: {exc.strerror or exc}") from exc
-        self._lines = self._valid_lines(text)
+        self._lines, self._numbers = self._valid_lines(text)
 
     @classmethod
     def from_text(cls, text: str, name: str = "<string>") -> MissionFile:
         """Parse mission-file text that is not on disk (handy for generated missions and tests)."""
         self = cls.__new__(cls)
         self.path = Path(name)
-        self._lines = self._valid_lines(text)
+        self._lines, self._numbers = self._valid_lines(text)
         return self
 
-    def _valid_lines(self, text: str) -> list[str]:
-        """The lines ``GetNextValidLine`` would return: trimmed, uncommented, defines expanded."""
+    def _valid_lines(self, text: str) -> tuple[list[str], list[int]]:
+        """The lines ``GetNextValidLine`` would return (trimmed, uncommented, defines expanded) and their numbers."""
         defines: dict[str, str] = {}
         lines: list[str] = []
+        numbers: list[int] = []
         for number, raw in enumerate(text.splitlines(), start=1):
             if len(raw) > MAX_LINE_CHARS:
                 log.warning("%s:%d: line longer than %d characters is cut", self.path, number, MAX_LINE_CHARS)
@@ -76,7 +78,8 @@ class MissionFile:
                 defines[match.group(1)] = match.group(2).strip()
                 continue
             lines.append(line)
-        return lines
+            numbers.append(number)
+        return lines, numbers
 
     def _lookup(self, name: str, defines: dict[str, str], number: int) -> str:
         if name in defines:
@@ -89,22 +92,43 @@ class MissionFile:
     # ---- global parameters ------------------------------------------------------------------------
     def global_value(self, name: str) -> str | None:
         """The value of global ``name`` (whitespace removed, as MOOS does), or None if absent."""
+        found = self._global(name)
+        return None if found is None else found[0]
+
+    def _global(self, name: str) -> tuple[str, int] | None:
+        """(value, line number) of global ``name``, or None."""
         wanted = name.strip().lower()
-        for line in self._lines:
+        for line, number in zip(self._lines, self._numbers):
             squeezed = _WHITESPACE.sub("", line)
             token, sep, value = squeezed.partition("=")
             if sep and token.lower() == wanted:
-                return value
+                return value, number
         return None
 
-    def _global_float(self, name: str) -> float | None:
-        value = self.global_value(name)
-        if value is None or value == "":
+    def global_number(self, name: str, low: float = -math.inf, high: float = math.inf,
+                      low_inclusive: bool = True) -> float | None:
+        """Global ``name`` as a finite number within [low, high] (or (low, high]), or None if absent or empty.
+
+        Raises ``MissionFileError`` naming the file, the line and the value otherwise.
+        """
+        found = self._global(name)
+        if found is None or found[0] == "":
             return None
+        value, number = found
         try:
-            return float(value)
+            result = float(value)
         except ValueError:
-            raise MissionFileError(f"{self.path}: {name} = {value!r} is not a number") from None
+            result = math.nan
+        in_range = (result >= low if low_inclusive else result > low) and result <= high
+        if not (math.isfinite(result) and in_range):
+            bounds = f"{'[' if low_inclusive else '('}{low:g}, {high:g}]"
+            raise MissionFileError(f"{self.path}:{number}: {name} = {value!r} is not a number in {bounds}")
+        return result
+
+    def check(self) -> None:
+        """Raise ``MissionFileError`` (file:line) for a malformed ``ProcessConfig`` block anywhere in the file."""
+        for name in self.process_names():
+            self._block_lines(name)
 
     @property
     def server_host(self) -> str:
@@ -114,7 +138,7 @@ class MissionFile:
     @property
     def server_port(self) -> int:
         """``ServerPort`` (default 9000)."""
-        value = self._global_float("ServerPort")
+        value = self.global_number("ServerPort", 0, 65535)
         return 9000 if value is None else int(value)
 
     @property
@@ -125,16 +149,16 @@ class MissionFile:
     @property
     def time_warp(self) -> float:
         """``MOOSTimeWarp`` (default 1.0)."""
-        value = self._global_float("MOOSTimeWarp")
+        value = self.global_number("MOOSTimeWarp", 0, math.inf, low_inclusive=False)
         return 1.0 if value is None else value
 
     @property
     def lat_origin(self) -> float | None:
-        return self._global_float("LatOrigin")
+        return self.global_number("LatOrigin", -90, 90)
 
     @property
     def long_origin(self) -> float | None:
-        return self._global_float("LongOrigin")
+        return self.global_number("LongOrigin", -180, 180)
 
     # ---- process blocks ---------------------------------------------------------------------------
     def process_names(self) -> list[str]:
@@ -155,14 +179,15 @@ class MissionFile:
         for i, line in enumerate(lines):
             if _WHITESPACE.sub("", line).lower() != header:
                 continue
+            where = f"{self.path}:{self._numbers[i]}"
             if i + 1 >= len(lines) or not lines[i + 1].startswith("{"):
-                raise MissionFileError(f"{self.path}: 'ProcessConfig = {app}' is not followed by '{{'")
+                raise MissionFileError(f"{where}: 'ProcessConfig = {app}' is not followed by '{{'")
             body = []
             for inner in lines[i + 2 :]:
                 if inner.startswith("}"):
                     return body
                 body.append(inner)
-            raise MissionFileError(f"{self.path}: block 'ProcessConfig = {app}' has no closing '}}'")
+            raise MissionFileError(f"{where}: block 'ProcessConfig = {app}' has no closing '}}'")
         return None
 
     def process_config(self, app: str) -> list[tuple[str, str]]:

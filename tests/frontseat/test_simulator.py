@@ -216,3 +216,16 @@ def test_frontseat_sim_process_usage_and_run() -> None:
         lines = client.read_until(lambda line: line.startswith("NAV"))
         assert lines[0] == protocol.CTRL_PAYLOAD
     assert sim.process.returncode == 0  # SIGTERM is a clean shutdown
+
+
+@pytest.mark.parametrize("fields", ["HEADING:0,SPEED:-5,DEPTH:0", "HEADING:0,SPEED:1e308,DEPTH:0",
+                                    "HEADING:1e20,SPEED:1,DEPTH:0", "HEADING:0,SPEED:1,DEPTH:-1",
+                                    "HEADING:0,SPEED:inf,DEPTH:0", "HEADING:nan,SPEED:1,DEPTH:0",
+                                    "HEADING:0,SPEED:1,DEPTH:11001"])
+def test_out_of_range_or_non_finite_commands_are_refused_and_change_nothing(fields: str) -> None:
+    sim = Simulation()
+    sim.handle_line(f"START,LAT:{LAT},LON:{LON}")
+    assert sim.handle_line("CMD,HEADING:-360,SPEED:100,DEPTH:11000") == [protocol.CMD_OK]  # the bounds are in
+    before = (sim.desired.hdg, sim.desired.v, sim.desired.z)
+    assert sim.handle_line(f"CMD,{fields}") == [protocol.CMD_ERROR]
+    assert (sim.desired.hdg, sim.desired.v, sim.desired.z) == before

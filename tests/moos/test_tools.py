@@ -47,6 +47,23 @@ def test_moos_db_console_script_uses_the_mission_file(tmp_path: Path) -> None:
     assert proc.returncode == 0
 
 
+@pytest.mark.parametrize("text, where", [
+    (None, "No such file"),
+    ("ServerPort = 9x\n", "m.moos:1: ServerPort = '9x' is not a number"),
+    ("// warp\n\nMOOSTimeWarp = -2\n", "m.moos:3: MOOSTimeWarp = '-2'"),
+    ("ServerPort = 0\nProcessConfig = a\n{\n  x = 1\n", "m.moos:2: block 'ProcessConfig = a' has no closing"),
+])
+def test_moos_db_exits_2_on_a_bad_mission_file_naming_file_and_line(tmp_path: Path, text: str | None,
+                                                                     where: str) -> None:
+    mission = tmp_path / "m.moos"
+    if text is not None:
+        mission.write_text(text)
+    run = subprocess.run([str(BIN / "moos-db"), str(mission)], capture_output=True, text=True, timeout=30,
+                         cwd=tmp_path)
+    assert run.returncode == 2
+    assert where in run.stderr and "listening" not in run.stdout
+
+
 def test_moos_db_refuses_a_taken_port(tmp_path: Path) -> None:
     with running_moosdb() as db:
         run = subprocess.run([str(BIN / "moos-db"), f"--moos_port={db.port}"], capture_output=True, text=True,

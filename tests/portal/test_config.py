@@ -72,6 +72,16 @@ def test_bad_file_names_file_and_line(tmp_path: Path) -> None:
         load_config(SampleAppConfig, [path], environ={})
 
 
+@pytest.mark.parametrize("text, line", [
+    ("app {\n  name: \"x\"\n\ninterprocess { platform: \"p\" }\n\n", 1),  # the parser blames line 4
+    ("app { name: \"{ #\" }\ninterprocess {  # a { in a comment\n  platform: \"p\"\n", 2),
+])
+def test_unclosed_brace_is_reported_where_it_opens(tmp_path: Path, text: str, line: int) -> None:
+    path = _write(tmp_path, text)
+    with pytest.raises(AppConfigError, match=rf"app.pb.cfg: line {line}: '{{' is never closed"):
+        load_config(SampleAppConfig, [path], environ={})
+
+
 @pytest.mark.parametrize("config_type", [SampleAppConfig, GobyDaemonConfig, GobyMOOSGatewayConfig])
 def test_example_config_is_complete_and_parses_back(config_type: type) -> None:
     text = example_config(config_type)

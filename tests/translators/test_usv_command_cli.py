@@ -31,6 +31,13 @@ def test_polygon_arguments_build_the_course_message():
     assert rest == ["--interprocess", "x"]  # left for the Goby configuration parser
 
 
+@pytest.mark.parametrize("timeout", ["-1", "0", "nan", "inf", "soon"])
+def test_timeout_must_be_a_finite_positive_number(timeout, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        parse(["waypoints", "--timeout", timeout])
+    assert exit_.value.code == 2 and "--timeout" in capsys.readouterr().err
+
+
 def test_waypoints_needs_no_shape():
     args, rest = parse(["waypoints"])
     assert build_command(args, 1.0) == USVCommand(time=1.0, desired_state=USVCommand.WAYPOINTS)

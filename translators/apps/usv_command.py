@@ -22,6 +22,7 @@ from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from translators.usv.protobuf.usv_config_pb2 import CommandTool
 from translators.usv.validation import DcclBoundsError, check_dccl_bounds
+from util.cli import positive_number
 
 log = logging.getLogger(__name__)
 
@@ -40,7 +41,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Other options (config file, --interprocess, -v, ...) are the usual Goby application options.",
     )
     common = argparse.ArgumentParser(add_help=False)
-    common.add_argument("--timeout", type=float, help="seconds to wait for the acknowledgement (default: "
+    common.add_argument("--timeout", type=positive_number, help="seconds to wait for the acknowledgement (default: "
                         "ack_timeout of the config, 10)")
     states = parser.add_subparsers(dest="state", required=True, metavar="{polygon,waypoints}")
     polygon = states.add_parser("polygon", parents=[common], help="loiter on a radial polygon centred at (0, 0)")

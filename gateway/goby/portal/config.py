@@ -42,7 +42,37 @@ def _merge_text(target: pb_message.Message, text: str, where: str) -> None:
     try:
         text_format.Merge(text, target)
     except text_format.ParseError as exc:
+        unclosed = unclosed_braces(text)
+        if unclosed:  # the parser trips over whatever follows; the real fault is the opening brace
+            lines = ", ".join(str(n) for n in unclosed)
+            raise AppConfigError(f"{where}: line {lines}: '{{' is never closed (parser: {exc})") from None
         raise AppConfigError(f"{where}: {exc}") from None
+
+
+def unclosed_braces(text: str) -> list[int]:
+    """Line numbers of ``{``/``<`` in protobuf text format that are never closed (strings and ``#`` skipped)."""
+    stack: list[int] = []
+    line, i, n = 1, 0, len(text)
+    while i < n:
+        ch = text[i]
+        if ch == "\n":
+            line += 1
+        elif ch == "#":
+            end = text.find("\n", i)
+            i = n if end < 0 else end
+            continue
+        elif ch in "\"'":
+            i += 1
+            while i < n and text[i] not in (ch, "\n"):
+                i += 2 if text[i] == "\\" else 1
+            if i < n and text[i] == "\n":
+                continue  # an unterminated string ends at the line's end; the newline is counted next
+        elif ch in "{<":
+            stack.append(line)
+        elif ch in "}>" and stack:
+            stack.pop()
+        i += 1
+    return stack
 
 
 def _scalar_override(field: pb_descriptor.FieldDescriptor, value: str) -> str:
