@@ -44,9 +44,10 @@ class Translator(SimpleThread):
 
     def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None) -> None:
         super().__init__(cfg, LOOP_FREQUENCY_HZ, index)
-        # Goby prints std::this_thread::get_id() (a pthread_t); the kernel thread id has the same shape and is
-        # unique across processes too, so two gateways on one MOOSDB never clash.
-        self._name = f"goby::moos::Translator::{threading.get_native_id()}"
+        # Goby3 (moos_plugin_translator.h translator_name()) streams std::this_thread::get_id(), which libstdc++
+        # prints as the pthread_t; threading.get_ident() is that same pthread_self() value. With address-space
+        # randomisation it differs between processes, so two gateways on one MOOSDB do not clash.
+        self._name = f"goby::moos::Translator::{threading.get_ident()}"
         sim = cfg.app.simulation.time
         # Goby's SetMOOSTimeWarp is process-global; our client gets a clock of its own instead, so translators
         # of different gateways (or tests) in one process neither share a warp nor overwrite each other's skew.

@@ -8,6 +8,12 @@ classes their full name. A published message's type is found from how the variab
 function (``msg = DesiredCourse()``), from an annotation (``msg: DesiredCourse``), or through protobuf
 fields (``data.node_status`` of an ``InterfaceData``). A call the analysis cannot resolve is an error that
 names the file and line, so an interface file can never silently miss a call.
+
+What the process runs besides its own modules is followed as goby_clang_tool follows template instantiations:
+a thread class given to ``launch_thread`` (a class, or the result of a lookup annotated ``-> type[...]`` such as
+an extension point's, which only imports) has its module analysed too; and every application class
+(``SingleThreadApplication``/``MultiThreadApplication``) publishes its configuration on ``goby::configuration``,
+as Goby's application base classes do.
 """
 
 from __future__ import annotations
@@ -32,6 +38,9 @@ FIRST_PARTY = ("gateway", "translators", "frontseat", "behaviors", "launch")
 # The transport itself publishes on internal groups (manager handshake and the like); Goby never lists those.
 EXCLUDED_PACKAGES = ("gateway.goby.portal", "launch.interfaces", "gateway.moos")
 LAYER_METHODS = {"interprocess": "interprocess", "interthread": "interthread", "intervehicle": "intervehicle"}
+
+
+CONFIGURATION_GROUP = "goby::configuration"
 
 
 class AnalysisError(LaunchError):
@@ -108,6 +117,7 @@ class _ModuleAnalyzer(ast.NodeVisitor):
         self.module = module
         self.path = source_path
         self.interface = interface
+        self.launched_modules: list[str] = []  # modules of thread classes this code launches
         self.class_stack: list[ast.ClassDef] = []
         self.func_stack: list[ast.FunctionDef | ast.AsyncFunctionDef] = []
         self.class_aliases: dict[str, dict[str, str]] = {}
@@ -273,8 +283,49 @@ class _ModuleAnalyzer(ast.NodeVisitor):
                         aliases[f"self.{target.attr}"] = layer
         self.class_aliases[node.name] = aliases
         self.class_stack.append(node)
+        self._announce_configuration(node)
         self.generic_visit(node)
         self.class_stack.pop()
+
+    def _announce_configuration(self, node: ast.ClassDef) -> None:
+        """An application class publishes its config type on ``goby::configuration`` (portal/application.py)."""
+        from gateway.goby.portal.application import _Application
+
+        cls = getattr(self.module, node.name, None)
+        if not (isinstance(cls, type) and issubclass(cls, _Application)):
+            return
+        try:
+            config_type = typing.get_type_hints(cls.__init__).get("cfg")
+        except Exception as exc:
+            raise AnalysisError(f"{self._where(node)}: cannot read the config type of {node.name}: {exc}") from exc
+        if not (isinstance(config_type, type) and issubclass(config_type, Message)):
+            raise AnalysisError(f"{self._where(node)}: annotate {node.name}.__init__'s cfg with its config message "
+                                "type (it is published on goby::configuration)")
+        if "interprocess" not in config_type.DESCRIPTOR.fields_by_name:
+            return
+        thread = self._thread_name()
+        self._note_thread(thread)
+        self.interface.add(PubSubEntry("interprocess", thread, CONFIGURATION_GROUP, "PROTOBUF",
+                                       cxx_type_name(config_type), "publishes"))
+
+    def _launched_class(self, expr: ast.expr, node: ast.AST) -> type:
+        """The class a ``launch_thread`` call starts: a class expression, or a local set by a class lookup."""
+        if isinstance(expr, ast.Name):
+            origin = _FunctionTypes(self.func_stack[-1] if self.func_stack else None).origins.get(expr.id)
+            if origin is not None and origin.call is not None:
+                callee = self._callee(origin.call.func, node)
+                result = typing.get_type_hints(callee).get("return") if callable(callee) else None
+                if typing.get_origin(result) is not type:
+                    raise AnalysisError(f"{self._where(node)}: `{ast.unparse(origin.call.func)}` must be annotated "
+                                        "`-> type[...]` for the analysis to follow the thread it launches")
+                value = self._eval(origin.call, node, "launched thread class")
+            else:
+                value = self._eval(expr, node, "launched thread class")
+        else:
+            value = self._eval(expr, node, "launched thread class")
+        if not isinstance(value, type):
+            raise AnalysisError(f"{self._where(node)}: `{ast.unparse(expr)}` is not a thread class")
+        return value
 
     def visit_FunctionDef(self, node: ast.FunctionDef) -> None:
         self.func_stack.append(node)
@@ -286,6 +337,11 @@ class _ModuleAnalyzer(ast.NodeVisitor):
     def visit_Call(self, node: ast.Call) -> None:
         self.generic_visit(node)
         func = node.func
+        if isinstance(func, ast.Attribute) and func.attr == "launch_thread" and node.args:
+            launched = self._launched_class(node.args[0], node)
+            if launched.__module__ != self.module.__name__:
+                self.launched_modules.append(launched.__module__)
+            return
         if not isinstance(func, ast.Attribute) or func.attr not in ("publish", "subscribe", "subscribe_regex"):
             return
         layer = _layer_of(func.value, self._aliases())
@@ -366,7 +422,9 @@ def analyze_modules(application: str, module_names: list[str], follow_imports: b
             continue
         tree = ast.parse(Path(source).read_text(), source)
         log.debug("analyzing %s", source)
-        _ModuleAnalyzer(module, Path(source), interface).visit(tree)
+        analyzer = _ModuleAnalyzer(module, Path(source), interface)
+        analyzer.visit(tree)
+        pending.extend(analyzer.launched_modules)
         if follow_imports:
             pending.extend(sorted(n for n in _first_party_imports(tree) if n.split(".")[0] in own_packages))
     return interface

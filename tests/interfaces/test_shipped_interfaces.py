@@ -28,6 +28,16 @@ ORIGINAL_FRONTSEAT_INTERFACE = {
     ("publishes", FS + "raw_in", PB + "Raw"),
     ("publishes", FS + "raw_out", PB + "Raw"),
     ("publishes", FS + "status", PB + "InterfaceStatus"),
+    # Goby's application base class announces the configuration at start
+    ("publishes", "goby::configuration", "goby::apps::zeromq::protobuf::FrontSeatInterfaceConfig"),
+}
+# The embedded FrontSeatTranslation (the moos_helm block; Goby's interface file lists it in goby_frontseat_interface
+# too): Goby3's frontseat_gateway_plugin.h/.cpp subscribe node_status and publish helm_state and desired_course;
+# ours also follows datum updates (docs/translators.md).
+ORIGINAL_FRONTSEAT_TRANSLATION = {
+    ("subscribes", FS + "node_status", PB + "NodeStatus"),
+    ("publishes", FS + "helm_state", PB + "HelmStateReport"),
+    ("publishes", FS + "desired_course", PB + "DesiredCourse"),
 }
 
 
@@ -35,7 +45,13 @@ def test_frontseat_interface_matches_the_original() -> None:
     interface = analyze_modules("frontseat-interface", SHIPPED_APPLICATIONS["frontseat-interface"])
     interprocess = [e for e in interface.entries if e.layer == "interprocess"]
     assert {e.scheme for e in interprocess} == {"PROTOBUF"}
-    assert {(e.direction, e.group, e.type) for e in interprocess} == ORIGINAL_FRONTSEAT_INTERFACE
+    by_thread: dict[str, set[tuple[str, str, str]]] = {}
+    for e in interprocess:
+        by_thread.setdefault(e.thread.rsplit(".", 1)[-1], set()).add((e.direction, e.group, e.type))
+    assert by_thread["FrontSeatInterface"] == ORIGINAL_FRONTSEAT_INTERFACE
+    extra = {("subscribes", "goby::datum_update", "goby::middleware::protobuf::DatumUpdate")}
+    assert by_thread["FrontSeatTranslation"] == ORIGINAL_FRONTSEAT_TRANSLATION | extra
+    assert set(by_thread) == {"FrontSeatInterface", "FrontSeatTranslation"}
 
 
 @pytest.mark.parametrize("app", sorted(SHIPPED_APPLICATIONS))

@@ -303,3 +303,19 @@ def test_a_thread_that_outlives_the_join_timeout_stays_listed_for_a_later_join()
         release.set()
         assert app.join_thread(Worker, timeout=10) == 1
         assert app.threads() == []
+
+
+def test_application_announces_its_configuration_on_goby_configuration(broker: BrokerProcess) -> None:
+    # Goby3's SingleThreadApplication/MultiThreadApplication constructors publish app_cfg() on goby::configuration
+    cfg = SampleAppConfig(count=42)
+    cfg.app.name = "announcer"
+    cfg.interprocess.CopyFrom(broker.interprocess_config())
+    with PortalClient(broker.interprocess_config(), "cfg_listener") as client:
+        announced = client.collect("goby::configuration", SampleAppConfig)
+        assert client.wait_subscribed()
+        with running_app(PortalApp, cfg) as app:
+            assert client.poll_until(lambda: bool(announced))
+    assert announced[0] == app.cfg() and announced[0].count == 42 and announced[0].app.name == "announcer"
+    entries = {(e.direction, e.group, e.scheme, e.type, e.thread) for e in app.context.registry.entries()}
+    assert ("publish", "goby::configuration", "PROTOBUF", "goby.test.zeromq.protobuf.SampleAppConfig",
+            "PortalApp") in entries

@@ -88,7 +88,8 @@ def test_both_directions_on_the_translator_thread(infrastructure, translator_cla
         with hosted_translators(cfg, translator_class):
             constructed = _events_until("constructed")[-1]
             ident, name = constructed[1], constructed[2]
-            assert re.fullmatch(r"goby::moos::Translator::\d+", name)
+            # Goby's translator_name(): the constructing thread's std::this_thread::get_id(), i.e. its pthread_t
+            assert name == f"goby::moos::Translator::{ident}"
             # MOOS -> Goby: the buffered B rides along with the IN that follows it
             seen: list[str] = []
             for attempt in range(100):  # until the translator has registered (it connects asynchronously)

@@ -7,11 +7,18 @@ import logging
 import threading
 from typing import Any
 
+from google.protobuf.message import Message
+
 from gateway.goby.portal.context import use_context
 from gateway.goby.portal.errors import ThreadError
+from gateway.goby.portal.group import Group
 from gateway.goby.portal.thread import SimpleThread, interprocess_config_of
 
 log = logging.getLogger(__name__)
+
+#: Goby3's ``goby::middleware::groups::configuration`` (src/middleware/application/groups.h): every application
+#: publishes its whole configuration there at start (single_thread.h / multi_thread.h constructors).
+CONFIGURATION_GROUP = Group("goby::configuration")
 
 
 class _Application(SimpleThread):
@@ -22,6 +29,8 @@ class _Application(SimpleThread):
         self._return_code = 0
         if interprocess_config_of(cfg) is not None:
             self.interprocess()
+            if isinstance(cfg, Message):  # Goby's start-up announcement (PROTOBUF; held until the broker releases)
+                self.interprocess().publish(CONFIGURATION_GROUP, cfg)
 
     @property
     def return_code(self) -> int:
