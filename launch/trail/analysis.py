@@ -28,7 +28,7 @@ def state_timeline(record: MissionRecord) -> list[tuple[float, str, str]]:
     for source, name in STATE_VARS:
         label = "interface" if name == "interface_state" else name
         out += [(t, label, v.removeprefix("INTERFACE_")) for t, v in transitions(record.events_named(name, source))]
-    return sorted(out)
+    return sorted(out, key=lambda item: item[0])  # stable: same-time changes keep their arrival order
 
 
 def distance_travelled(nav: list[NavSample]) -> float:

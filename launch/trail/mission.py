@@ -151,10 +151,24 @@ class TrailMission:
                 run.moos.start()
         self.group.on_wait = self.poll_moos
         self.group.start()
+        # The outer launch returns once the inner launchers run; their brokers come up a little later.
+        self.wait_for_brokers()
         for run in self.runs.values():
             if run.vehicle.kind != "topside":
                 run.portal = PortalRecorder(run.record, self.clock, run.vehicle.name, run.vehicle.ipc_base(self.settings))
                 run.portal.start()
+
+    def wait_for_brokers(self, timeout_s: float = 120.0) -> None:
+        """Block until every recorded vehicle's broker has its manager socket (portal clients time out otherwise)."""
+        deadline = time.monotonic() + timeout_s
+        sockets = {name: Path(run.vehicle.ipc_base(self.settings) + ".manager") for name, run in self.runs.items()}
+        while missing := [name for name, path in sockets.items() if not path.exists()]:
+            if self.stop_event.is_set():
+                return
+            self.poll()
+            if time.monotonic() > deadline:
+                raise LaunchError(f"no broker for {', '.join(missing)} within {timeout_s:g} s (logs in {self.log_dir})")
+            time.sleep(0.1)
 
     def add_hook(self, hook: Callable[[], None]) -> None:
         """Called on every poll (the demo's commander and link counters)."""
