@@ -5,12 +5,18 @@ The USV's nav and the RECOVER command normally reach this AUV over the acoustic 
 which republishes them on interprocess. Here a test double stands in for that hop: a portal client on the AUV's
 broker publishes ``goby3_course::usv_nav`` (NavigationReport, PROTOBUF scheme, as the manager does) for a USV
 driving east at 1.5 m/s, and later ``goby3_course::auv_command`` RECOVER. Everything after that hop is real.
+Midway the AUV's simulator is killed and a new one started on its port (the run keeps going past the death, as
+the demo's ``--keep-going``): the interface reconnects, returns to COMMAND and the AUV rejoins the trail.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import shutil
+import signal
+import subprocess
+import sys
 import time
 
 from gateway.goby.portal import Scheme
@@ -31,13 +37,14 @@ def _installed(entries: list[LaunchEntry]) -> list[LaunchEntry]:
     return [e for e in entries if not e.command.startswith("auv-manager") or shutil.which("auv-manager")]
 
 
-def test_one_auv_dives_trails_the_usv_contact_and_recovers(tmp_path):
+def test_one_auv_trails_the_usv_contact_survives_a_simulator_restart_and_recovers(tmp_path):
     vehicle = Vehicle("auv", 2, 1)  # index 1 of 2: trail angle 270 (the USV's port beam), depth 20 m
     settings = with_free_ports(TrailSettings(run_dir=tmp_path, warp=WARP, socket_dir=tmp_path), 2,
                                prefer_course=False)
     entries = [e for e in _installed(platform_entries(vehicle)) if not e.command.startswith("auv-manager")]
     mission = TrailMission(settings, 2, entries=entries, vehicles=[vehicle], extra_env=auv_slice_env(vehicle),
-                           platform=vehicle.name, launch_delay_s=0.1, report=lambda line: None)
+                           platform=vehicle.name, launch_delay_s=0.1, report=lambda line: None, keep_going=True)
+    new_sim: subprocess.Popen[bytes] | None = None
     usv_start = (0.0, 60.0)
     client: PortalClient | None = None
     state = {"last": -1e9, "t_recover": None}
@@ -62,11 +69,24 @@ def test_one_auv_dives_trails_the_usv_contact_and_recovers(tmp_path):
         assert client.wait_ready(30)
         mission.add_hook(publish_usv_nav)
         mission.wait_for_command(timeout_s=120)
-        mission.run(400)
+        mission.run(150)
+        # the simulator restarts: the interface leaves COMMAND, reconnects, and the AUV (back at the origin) rejoins
+        assert mission.group is not None
+        sim = next(p for p in mission.group.processes if p.name.endswith("frontseat-sim"))
+        os.killpg(sim.pid, signal.SIGKILL)
+        t_kill = mission.now()
+        new_sim = subprocess.Popen([sys.executable, "-m", "frontseat.apps.frontseat_sim",
+                                    str(vehicle.sim_port(settings))], stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
         record = mission.runs[vehicle.name].record
+        states_after = lambda: [e.value for e in record.events_named("interface_state", "interface") if e.t > t_kill]  # noqa: E731
+        mission.run(None, until=lambda: "INTERFACE_COMMAND" in states_after() or mission.now() - t_kill > 400)
+        assert states_after()[-1] == "INTERFACE_COMMAND" and len(states_after()) > 1, states_after()
+        assert [name for _, name, _ in mission.deaths] == [sim.name]
+        t_back = mission.now()
+        mission.run(None, until=lambda: mission.now() - t_back > 250)
         nav = record.snapshot()[0]
         t_end = mission.now()
-        # trailing: within the last 100 s, near the trail point 50 m off the USV's port beam, at 20 m
+        # trailing again: within the last 100 s, near the trail point 50 m off the USV's port beam, at 20 m
         recent = [s for s in nav if s.t > t_end - 100]
         ux, uy = usv_position(t_end)
         last = nav[-1]
@@ -92,8 +112,11 @@ def test_one_auv_dives_trails_the_usv_contact_and_recovers(tmp_path):
         if client is not None:
             client.close()
         result = mission.stop()
+        if new_sim is not None:
+            new_sim.terminate()
+            new_sim.wait(timeout=30)
     assert result.command_times[vehicle.name] is not None
-    assert all(o.clean for o in result.outcomes), result.outcomes
+    assert all(o.clean for o in result.outcomes if not o.name.endswith("frontseat-sim")), result.outcomes
     assert not result.log_errors, result.log_errors[:10]
 
 
