@@ -1,7 +1,9 @@
 """goby-helm-example: the goby3-course day-3 homework helm, on our Goby-style portal, with no MOOS at all.
 
 Drives a rough triangle through the frontseat interface: east at ``speed`` for ``east_duration`` s, south for
-``south_duration`` s, then northwest until the vehicle stops closing on where it started, then speed 0.
+``south_duration`` s, then northwest until the vehicle stops closing on where it started, then speed 0 and, once,
+an ``AUVCommand`` RECOVER on intervehicle ``goby3_course::auv_command`` (homework 3's second part: the AUVs
+surface and station-keep).
 Every loop (1 Hz of warped time, as the course's app) it publishes ``HELM_DRIVE`` on ``helm_state`` and a
 ``DesiredCourse`` on ``desired_course``; it reads ``node_status`` (the first one is the start).
 
@@ -21,6 +23,8 @@ from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import DesiredCourse, NodeStatus
 from frontseat.protobuf.frontseat_pb2 import HELM_DRIVE, HelmStateReport
 from gateway.goby.portal import SingleThreadApplication, run_application
+from translators.trail import groups as trail_groups
+from translators.usv.protobuf.command_dccl_pb2 import AUVCommand
 
 log = logging.getLogger(__name__)
 
@@ -92,6 +96,7 @@ class GobyHelmExample(SingleThreadApplication):
         super().__init__(cfg, loop_frequency_hz=1.0)
         self.legs = TriangleLegs(cfg.speed, cfg.east_duration, cfg.south_duration, max(1, cfg.closing_window))
         self._position: tuple[float, float] | None = None
+        self._recover_sent = False
         self.interprocess().subscribe(groups.node_status, NodeStatus, self._on_node_status)
 
     def _on_node_status(self, status: NodeStatus) -> None:
@@ -102,9 +107,17 @@ class GobyHelmExample(SingleThreadApplication):
     def loop(self) -> None:
         now = self.context.clock.now()
         heading, speed = self.legs.update(now, self._position)
+        if self.legs.leg is Leg.RECOVER and not self._recover_sent:
+            self._send_auv_command(now)
         self.interprocess().publish(groups.helm_state, HelmStateReport(state=HELM_DRIVE))
         self.interprocess().publish(groups.desired_course, DesiredCourse(time=now, heading=heading, speed=speed))
         log.debug("leg %s: heading %.0f speed %.1f", self.legs.leg.name, heading, speed)
+
+    def _send_auv_command(self, now: float) -> None:
+        """AUVCommand RECOVER, once, with the default publisher (the AUVs' subscriptions ask for the ack)."""
+        self._recover_sent = True
+        log.info("sending AUVCommand RECOVER on %s", trail_groups.auv_command)
+        self.intervehicle().publish(trail_groups.auv_command, AUVCommand(time=now, desired_state=AUVCommand.RECOVER))
 
 
 def main(argv: list[str] | None = None) -> int:

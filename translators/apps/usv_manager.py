@@ -14,6 +14,7 @@ import logging
 from google.protobuf import text_format
 
 from gateway.goby.portal import SingleThreadApplication, run_application
+from translators.trail.managers import forward_usv_nav
 from translators.usv import groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
@@ -28,6 +29,7 @@ class USVManager(SingleThreadApplication):
 
     def __init__(self, cfg: USVManagerConfig) -> None:
         super().__init__(cfg)
+        forward_usv_nav(self, cfg)  # the course's subscribe_our_nav and subscribe_auv_nav
         self.interprocess().subscribe(groups.shore_usv_command, USVCommand, self._on_shore_command)
         log.info("waiting for USV commands on %s", groups.shore_usv_command)
 
