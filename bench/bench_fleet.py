@@ -55,6 +55,29 @@ def _subtree(root: int, tree: dict[int, list[int]]) -> list[int]:
     return out
 
 
+def _program(pid: int) -> str:
+    """A process's program: the console script or ``-m`` module it runs (``moos-db``, ``launch.trail.moos_gen``)."""
+    try:
+        argv = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+    except OSError:
+        return "?"
+    args = [a.decode(errors="replace") for a in argv if a]
+    if len(args) > 2 and args[1] == "-m":
+        return args[2]
+    if len(args) > 1 and "python" in Path(args[0]).name:
+        return Path(args[1]).name
+    return Path(args[0]).name if args else "?"
+
+
+def _cpu_by_program(pids: list[int]) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for pid in pids:
+        cpu, _ = _cpu_and_rss([pid])
+        name = _program(pid)
+        out[name] = out.get(name, 0.0) + cpu
+    return out
+
+
 def _cpu_and_rss(pids: list[int]) -> tuple[float, int]:
     cpu, rss = 0.0, 0
     for pid in pids:
@@ -82,13 +105,17 @@ def measure(n_auvs: int, warp: int, sim_seconds: float) -> dict[str, object]:
         assert mission.group is not None
         roots = {p.name: p.pid for p in mission.group.processes}
         tree = _children()
-        cpu0 = sum(_cpu_and_rss(_subtree(pid, tree))[0] for pid in roots.values())
+        all0 = [pid for root in roots.values() for pid in _subtree(root, tree)]
+        cpu0 = _cpu_and_rss(all0)[0]
+        programs0 = _cpu_by_program(all0)
         nav0 = {name: len(run.record.snapshot()[0]) for name, run in mission.runs.items()}
         real0, sim0 = time.monotonic(), mission.now()
         mission.run(None, until=lambda: mission.now() - sim0 >= sim_seconds)
         real, sim = time.monotonic() - real0, mission.now() - sim0
         tree = _children()
         per_platform = {name: _cpu_and_rss(_subtree(pid, tree)) for name, pid in roots.items()}
+        programs = _cpu_by_program([pid for root in roots.values() for pid in _subtree(root, tree)])
+        row["programs"] = {k: (v - programs0.get(k, 0.0)) / sim for k, v in programs.items()}
         cpu = sum(c for c, _ in per_platform.values()) - cpu0
         row["cpu_per_sim_s"] = cpu / sim
         row["core_share"] = cpu / real / (os.cpu_count() or 1)
@@ -122,8 +149,10 @@ def main(argv: list[str] | None = None) -> int:
     header = (f"{'AUVs':>4} {'start-up s':>10} {'CPU s/sim s':>11} {'cores used':>10} {'RSS MB/veh':>10} "
               f"{'NAV/sim s':>9} {'kept up':>7} {'sat. link':>9} {'acomms':>7}")
     print(header)
+    last: dict[str, object] | None = None
     for n in sizes:
         row = measure(n, args.warp, args.sim)
+        last = row if "programs" in row else last
         if "error" in row:
             print(f"{n:>4} failed: {row['error']}", flush=True)
             continue
@@ -131,6 +160,12 @@ def main(argv: list[str] | None = None) -> int:
               f"{row['rss_mb_per_vehicle']:>10.0f} {row['nav_per_sim_s_min']:>9.2f} "
               f"{'yes' if row['kept_up'] else 'NO':>7} {_pct(row['sat_satellite']):>9} {_pct(row['sat_acomms']):>7}",
               flush=True)
+    if last is not None:
+        programs: dict[str, float] = last["programs"]  # type: ignore[assignment]
+        total = sum(programs.values()) or 1.0
+        top = sorted(programs.items(), key=lambda kv: -kv[1])[:8]
+        print(f"CPU by program with {last['auvs']} AUVs (CPU s per sim s, share): "
+              + ", ".join(f"{name} {cpu:.3f} ({100 * cpu / total:.0f}%)" for name, cpu in top))
     return 0
 
 

@@ -317,8 +317,9 @@ def with_free_ports(settings: TrailSettings, n_auvs: int, prefer_course: bool = 
     options = [(9000, 55000, 50000, 54500)] if prefer_course else []
     rng = random.Random()
     for _ in range(50):
-        base = rng.randrange(20000, 29000, 100)
-        options.append((base, base + 10000, base + 20000, base + 30000))
+        # below the kernel's ephemeral range (32768+), so no outgoing connection takes a port between check and use
+        base = rng.randrange(10000, 16000, 100)
+        options.append((base, base + 5000, base + 10000, base + 15000))
     for moos, sim, liaison, link in options:
         ports = [*(moos + i for i in ids), *(sim + i for i in ids), *(liaison + i for i in ids), link, link + 1]
         if _ports_free(ports):
