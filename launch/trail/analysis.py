@@ -156,9 +156,18 @@ class CommandOutcome:
 
     what: str
     sent_at: float
-    acked_at: float | None
-    expired: str | None
+    acks: list[tuple[float, str]]  # (time, who acked: "modem N, latency ...")
+    expires: list[tuple[float, str]]  # (time, reason), e.g. on a link with no subscriber for it
     arrived_at: dict[str, float]  # vehicle name -> time its MOOSDB got the resulting state
+
+    @property
+    def acked_at(self) -> float | None:
+        return self.acks[0][0] if self.acks else None
+
+    @property
+    def expired(self) -> str | None:
+        """Why it expired, when it was never acked."""
+        return self.expires[0][1] if self.expires and not self.acks else None
 
     @property
     def latencies(self) -> list[float]:
@@ -171,9 +180,6 @@ def command_outcomes(operator: MissionRecord, vehicles: dict[str, MissionRecord]
     sent = [e for e in events if e.source == "command" and e.name == "sent"]
     out: list[CommandOutcome] = []
     for i, command in enumerate(sent):
-        following = [e for e in events if e.t >= command.t and e.value == command.value]
-        ack = next((e.t for e in following if e.name == "ack"), None)
-        expired = next((e.origin for e in following if e.name == "expire"), None)
         next_sent = sent[i + 1].t if i + 1 < len(sent) else math.inf
         arrived: dict[str, float] = {}
         if command.value == "recover":
@@ -186,7 +192,9 @@ def command_outcomes(operator: MissionRecord, vehicles: dict[str, MissionRecord]
             hit = _first(record.events_named(var, "moos"), command.t, next_sent, expected)
             if hit is not None:
                 arrived[name] = hit.t
-        out.append(CommandOutcome(command.value, command.t, ack, expired, arrived))
+        mine = [e for e in events if command.t <= e.t < next_sent and e.value == command.value]
+        out.append(CommandOutcome(command.value, command.t, [(e.t, e.origin) for e in mine if e.name == "ack"],
+                                  [(e.t, e.origin) for e in mine if e.name == "expire"], arrived))
     return out
 
 

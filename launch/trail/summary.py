@@ -70,8 +70,8 @@ def summary_text(result: TrailResult, trails: list[TrailPerformance], commands: 
                      f"deg; depth error {trail.depth_error} m")
     lines.append("commands (sent from the topside over satellite / RECOVER from the USV over acomms):")
     for n, command in enumerate(commands, start=1):
-        ack = f"acked t={command.acked_at:.0f}" if command.acked_at is not None else (
-            f"EXPIRED ({command.expired})" if command.expired else "not acked")
+        ack = (f"acked t={command.acked_at:.0f} ({'; '.join(who for _, who in command.acks)})" if command.acks else
+               f"EXPIRED ({command.expired})" if command.expired else "not acked")
         arrived = ", ".join(f"{v} t={t:.0f} (+{t - command.sent_at:.0f} s)" for v, t in command.arrived_at.items())
         lines.append(f"  {n}. {command.what}: sent t={command.sent_at:.0f}, {ack}; in MOOS: {arrived or 'never'}")
     latencies = [x for c in commands for x in c.latencies]

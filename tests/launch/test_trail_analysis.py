@@ -84,6 +84,7 @@ def test_commands_acks_and_latency():
     result = TrailResult(records={"usv": usv, "auv0": auv0}, command_times={"usv": 5, "auv0": None}, t0=0)
     text = summary_text(result, [], outcomes, [], None, 300, topside_view={"USV": 3})
     assert "3. recover: sent t=200, EXPIRED (EXPIRED_TIME_TO_LIVE_EXCEEDED); in MOOS: auv0 t=240 (+40 s)" in text
+    assert "1. polygon --sides 6 --radius 200: sent t=10, acked t=18 (modem 2)" in text
     assert "mean 25.0 s, max 40.0 s over 3 arrivals" in text and "USV x3" in text
 
 

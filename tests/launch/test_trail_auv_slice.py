@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -21,7 +20,6 @@ import time
 
 from gateway.goby.portal import Scheme
 from gateway.goby.portal.testing import PortalClient
-from launch.launchfile import LaunchEntry
 from launch.trail.mission import TrailMission, auv_slice_env, platform_entries, with_free_ports
 from launch.trail.settings import TrailSettings, Vehicle
 from translators.trail import groups
@@ -32,16 +30,12 @@ WARP = 20
 USV_SPEED = 1.5
 
 
-def _installed(entries: list[LaunchEntry]) -> list[LaunchEntry]:
-    """The lines whose program is installed (the AUV manager is the one hop the test double replaces)."""
-    return [e for e in entries if not e.command.startswith("auv-manager") or shutil.which("auv-manager")]
-
-
 def test_one_auv_trails_the_usv_contact_survives_a_simulator_restart_and_recovers(tmp_path):
     vehicle = Vehicle("auv", 2, 1)  # index 1 of 2: trail angle 270 (the USV's port beam), depth 20 m
     settings = with_free_ports(TrailSettings(run_dir=tmp_path, warp=WARP, socket_dir=tmp_path), 2,
                                prefer_course=False)
-    entries = [e for e in _installed(platform_entries(vehicle)) if not e.command.startswith("auv-manager")]
+    # the AUV manager's hop (acomms in, interprocess out) is the one the test double replaces
+    entries = [e for e in platform_entries(vehicle) if not e.command.startswith("auv-manager")]
     mission = TrailMission(settings, 2, entries=entries, vehicles=[vehicle], extra_env=auv_slice_env(vehicle),
                            platform=vehicle.name, launch_delay_s=0.1, report=lambda line: None, keep_going=True)
     new_sim: subprocess.Popen[bytes] | None = None

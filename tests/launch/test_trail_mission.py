@@ -16,6 +16,7 @@ import shutil
 
 import pytest
 
+from launch.process_group import child_environment
 from launch.record import MissionRecord, shifted
 from launch.trail.analysis import command_outcomes, recover_outcome, trail_performance
 from launch.trail.links import LinkMonitor
@@ -29,7 +30,7 @@ SCHEDULE = "0:polygon:6:200,200:waypoints,350:recover"
 DURATION = 550.0
 NEEDED = ("auv-manager", "topside-manager", "usv-manager")
 
-pytestmark = pytest.mark.skipif(any(shutil.which(p) is None for p in NEEDED),
+pytestmark = pytest.mark.skipif(any(shutil.which(p, path=child_environment()["PATH"]) is None for p in NEEDED),
                                 reason=f"the course's managers ({', '.join(NEEDED)}) are not installed yet")
 
 
@@ -63,7 +64,7 @@ def test_trail_mission_two_auvs(tmp_path):
         result = mission.stop()
 
     records = result.records
-    assert all(t is not None for t in result.command_times.values()), result.command_times
+    assert all(t is not None for name, t in result.command_times.items() if name != "topside"), result.command_times
     operator_events = shifted(operator_record, result.t0)
     seen = {e.value for e in operator_events.events_named("node_status", "topside")}
     assert {"USV", "AUV_0", "AUV_1"} <= seen, seen
