@@ -21,6 +21,7 @@ SHIPPED_APPLICATIONS: dict[str, list[str]] = {
     "usv-mission-shore": ["launch.usv.shore"],
     "usv-mission-recorder": ["launch.recorder"],
     "trail-mission-operator": ["launch.trail.operator"],
+    "moos-gateway-goby3-course-plugin": ["translators.trail.ivp_helm_translation", "translators.usv.command_translation"],
 }
 
 

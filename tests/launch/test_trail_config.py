@@ -229,3 +229,15 @@ def test_nested_goby_launch_stops_inner_processes_first_and_logs_beneath_the_par
     for platform in ("one", "two"):
         assert "inner stopped" in (logs / platform / f"{platform}.worker.log").read_text()
         assert "Cleaning up" in (logs / ("first" if platform == "one" else "second")).with_suffix(".log").read_text()
+
+
+def test_trail_deployment_is_generated_from_the_code():
+    from launch.interfaces.deployment import DEFAULT_INTERFACES_DIR, load_deployment
+    from launch.trail.deployment import deployment_text
+
+    path = DEFAULT_INTERFACES_DIR / "trail_deployment.yml"
+    assert path.read_text() == deployment_text(4), "stale: run `python -m launch.trail.deployment 4`"
+    deployment = load_deployment(path)
+    assert list(deployment.platforms) == ["topside", "usv", "auv0", "auv1", "auv2", "auv3"]
+    usv_apps = set(deployment.platforms["usv"].modules["nomodule"].applications)
+    assert {"usv-manager", "frontseat-interface", "moos-gateway"} <= usv_apps
