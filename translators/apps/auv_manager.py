@@ -1,9 +1,9 @@
-"""auv-manager: the Goby3 course's goby3_course_auv_manager (see ``translators.trail.managers.AUVManager``)."""
+"""auv-manager: the Goby3 course's goby3_course_auv_manager (see ``translators.trail.auv_manager.AUVManager``)."""
 
 from __future__ import annotations
 
 from gateway.goby.portal import run_application
-from translators.trail.managers import AUVManager
+from translators.trail.auv_manager import AUVManager
 from translators.trail.protobuf.manager_config_pb2 import AUVManager as AUVManagerConfig
 
 

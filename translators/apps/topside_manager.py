@@ -1,10 +1,10 @@
-"""topside-manager: the Goby3 course's goby3_course_topside_manager (see ``translators.trail.managers.TopsideManager``)."""
+"""topside-manager: the Goby3 course's goby3_course_topside_manager (see ``translators.trail.topside_manager.TopsideManager``)."""
 
 from __future__ import annotations
 
 from gateway.goby.portal import run_application
-from translators.trail.managers import TopsideManager
 from translators.trail.protobuf.manager_config_pb2 import TopsideManager as TopsideManagerConfig
+from translators.trail.topside_manager import TopsideManager
 
 
 def main(argv: list[str] | None = None) -> int:

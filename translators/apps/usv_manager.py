@@ -13,8 +13,13 @@ import logging
 
 from google.protobuf import text_format
 
+from frontseat import groups as frontseat_groups
+from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
 from gateway.goby.portal import SingleThreadApplication, run_application
-from translators.trail.managers import forward_usv_nav
+from translators.trail import groups as trail_groups
+from translators.trail.nav_convert import to_navigation_report
+from translators.trail.nav_links import link_cfg, nav_publisher, nav_subscriber, required_geodesy
+from translators.trail.protobuf.nav_dccl_pb2 import NavigationReport
 from translators.usv import groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
@@ -29,7 +34,7 @@ class USVManager(SingleThreadApplication):
 
     def __init__(self, cfg: USVManagerConfig) -> None:
         super().__init__(cfg)
-        forward_usv_nav(self, cfg)  # the course's subscribe_our_nav and subscribe_auv_nav
+        self._subscribe_nav(cfg)  # the course's subscribe_our_nav and subscribe_auv_nav
         self.interprocess().subscribe(groups.shore_usv_command, USVCommand, self._on_shore_command)
         log.info("waiting for USV commands on %s", groups.shore_usv_command)
 
@@ -52,6 +57,30 @@ class USVManager(SingleThreadApplication):
         ack.stage = USVCommandAck.RECEIVED_BY_MANAGER
         self.interprocess().publish(groups.usv_command_ack, ack)
         self.interprocess().publish(groups.usv_command, checked)
+
+    def _subscribe_nav(self, cfg: USVManagerConfig) -> None:
+        """Own nav out as ``usv_nav``; each ``auv_modem_id``'s ``auv_nav`` (no ack, newest only) forwarded topside.
+        Without ``app.geodesy`` (the course's manager requires it) only commands are carried, with a warning."""
+        if not cfg.app.HasField("geodesy"):
+            log.warning("no app.geodesy: navigation is not forwarded (usv_nav, auv_nav)")
+            return
+        self._vehicle_id = cfg.vehicle_id
+        self._geodesy = required_geodesy(cfg, "usv-manager")
+        self.interprocess().subscribe(frontseat_groups.node_status, NodeStatus, self._on_our_nav)
+        for modem_id in cfg.auv_modem_id:  # one Subscription per AUV; as in Goby the handler is the same one
+            auv_cfg = link_cfg(modem_id, ack_required=False, max_queue=1, newest_first=True)
+            self.intervehicle().subscribe(trail_groups.auv_nav, NavigationReport, self._on_auv_nav,
+                                          subscriber=nav_subscriber(auv_cfg, republish=False))
+
+    def _on_our_nav(self, status: NodeStatus) -> None:
+        """Send our own nav as ``usv_nav``. Runs on the application's main thread."""
+        nav = to_navigation_report(status, self._vehicle_id, self._geodesy, self.context.clock)
+        self.intervehicle().publish(trail_groups.usv_nav, nav, publisher=nav_publisher())
+
+    def _on_auv_nav(self, nav: NavigationReport) -> None:
+        """Forward an AUV's nav topside. Runs on the application's main thread."""
+        log.debug("Received DCCL nav: %s", text_format.MessageToString(nav, as_one_line=True))
+        self.intervehicle().publish(trail_groups.auv_nav, nav, publisher=nav_publisher())
 
 
 def main(argv: list[str] | None = None) -> int:
