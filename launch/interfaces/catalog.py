@@ -16,8 +16,6 @@ SHIPPED_APPLICATIONS: dict[str, list[str]] = {
     "usv-command": ["translators.apps.usv_command"],
     "auv-manager": ["translators.apps.auv_manager", "translators.trail.auv_manager"],
     "topside-manager": ["translators.apps.topside_manager", "translators.trail.topside_manager"],
-    "moos-gateway-goby3-course-plugin": ["translators.trail.gateway_plugin", "translators.trail.ivp_helm_translation",
-                                         "translators.usv.command_translation"],
     "moos-gateway-frontseat-plugin": ["translators.frontseat.translation"],
     "moos-gateway-usv-command-plugin": ["translators.usv.command_translation"],
     "moos-gateway-node-report-plugin": ["translators.node_report"],
