@@ -13,7 +13,7 @@ import time as _time
 
 from .active_queue import MessageCallback
 from .clock import DEFAULT_CLOCK, MoosClock
-from .engine import Callback, ClientEngine
+from .engine import Callback, ClientEngine, UndeliveredCallback
 from .errors import MoosError
 from .message import (
     BINARY,
@@ -91,6 +91,13 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
         """``func()`` runs on the client's I/O thread after mail arrives; it should only wake its owner,
         which then calls :meth:`fetch` on its own thread (or call ``fetch`` right there, as pymoos scripts do)."""
         self._on_mail = func
+        return True
+
+    def set_on_undelivered_callback(self, func: UndeliveredCallback) -> bool:
+        """Extension (pymoos has none): ``func(messages)`` gets the messages ``notify`` accepted that may not
+        have reached the DB: written but unconfirmed when the connection was lost, or discarded by ``close``.
+        Runs on the comms I/O thread (or the thread calling ``close``). See docs/moos.md "Restarts"."""
+        self._on_undelivered = func
         return True
 
     def has_mail_callback(self) -> bool:
@@ -297,6 +304,14 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
 
     def get_number_bytes_read(self) -> int:
         return self._bytes_read_total + (self._conn.bytes_read if self._conn else 0)
+
+    def get_number_of_refused_messages(self) -> int:
+        """Extension: posts that returned False because the client was not connected (pymoos drops them)."""
+        return self._refused
+
+    def get_number_of_undelivered_messages(self) -> int:
+        """Extension: accepted posts reported through the on-undelivered callback."""
+        return self._undelivered
 
     def get_number_messages_sent(self) -> int:
         return self._messages_sent

@@ -9,6 +9,13 @@ Writes from application threads go straight to the socket when the link is idle 
 batched by the writer thread when they come in bursts (throughput). A sender that outruns the link blocks in
 ``notify`` (back-pressure); nothing is dropped quietly. Messages are encoded when posted, so the outbox holds
 bytes and a batch is framed with one join.
+
+Accounting across DB restarts (docs/moos.md "Restarts"): a post while disconnected is refused (False, as
+pymoos) and counted; what was queued when the link went down is sent, in order, after the reconnection. A
+written batch is only *confirmed* when the DB has processed it: an asynchronous batch starts with a timing
+message whose id the DB echoes after processing the packet, a synchronous one gets its reply. Batches written but
+unconfirmed when the connection is lost (the message in flight at a crash) are reported undelivered through the
+on-undelivered callback and a counter, never assumed sent; so are messages discarded by ``close``.
 """
 
 from __future__ import annotations
@@ -18,11 +25,11 @@ import socket
 import threading
 import time as _time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 from .active_queue import ActiveQueueRouter
 from .clock import MoosClock
-from .codec import encode_fields, encode_message, frame_packet
+from .codec import PacketReader, encode_fields, encode_message, frame_packet
 from .connection import PacketSocket, Welcome, client_handshake, open_socket
 from .errors import ConnectionClosedError, HandshakeError, MoosError, PoisonedError, ProtocolError
 from .message import DOUBLE, NOTIFY, NULL_MSG, TIMING, TIMING_KEY, MoosMessage, to_bytes
@@ -37,6 +44,7 @@ DEFAULT_INBOX_LIMIT = 200_000
 BURST_WINDOW_S = 0.0002  # a write sooner than this after the last one is left to the writer thread to batch
 
 Callback = Callable[[], object]
+UndeliveredCallback = Callable[[list[MoosMessage]], object]
 
 
 class ClientEngine:
@@ -51,6 +59,7 @@ class ClientEngine:
         self._outbox_limit = DEFAULT_OUTBOX_LIMIT
         self._busy = False  # a thread is writing to the socket
         self._live = False  # connected (a plain flag for the hot path; _connected is for waiting)
+        self._writable = False  # live and on-connect has run: queued mail may go (after the re-registrations)
         self._writer_waiting = False
         self._space_waiters = 0
         self._io_ident = -1
@@ -93,6 +102,13 @@ class ClientEngine:
         self._bytes_sent_total = 0
         self._bytes_read_total = 0
         self._fatal: MoosError | None = None
+        # Written batches the DB has not confirmed yet: (confirmation token, encoded messages), oldest first.
+        self._unconfirmed: deque[tuple[int, list[bytes]]] = deque()
+        self._token = 0
+        self._skew_token = -1  # the token of the last timing message sent to measure the skew (once a second)
+        self._refused = 0  # posts refused because the link was down
+        self._undelivered = 0  # accepted posts reported undelivered (in flight at a crash, or discarded by close)
+        self._on_undelivered: UndeliveredCallback | None = None
         self.welcome: Welcome | None = None  # the DB's last WELCOME (community, skew, DB time, hostname)
 
     @property
@@ -138,10 +154,11 @@ class ClientEngine:
         self._queues.stop_all()
         with self._lock:
             self._running = False
-            if self._outbox:
-                log.warning("%s: closed with %d message(s) still unsent; they are discarded",
-                            self._name, len(self._outbox))
-            self._outbox.clear()
+            discarded, self._outbox = self._outbox, []
+        if discarded:
+            log.warning("%s: closed with %d message(s) still unsent; they are reported undelivered",
+                        self._name, len(discarded))
+            self._report_undelivered([discarded])
 
     # ---- outgoing path -----------------------------------------------------------------------------
     def _key(self, name: str) -> bytes:
@@ -167,6 +184,7 @@ class ClientEngine:
         on_io_thread = threading.get_ident() == self._io_ident
         with self._lock:
             if not self._live:
+                self._refused += 1
                 return False
             if msg_id is None:
                 msg_id = self._next_id
@@ -178,6 +196,7 @@ class ClientEngine:
             )
             direct = (
                 self._async
+                and self._writable
                 and not self._busy
                 and not on_io_thread
                 and self._out_delay <= 0.0
@@ -205,12 +224,17 @@ class ClientEngine:
     def _take_batch(self) -> tuple[list[bytes], PacketSocket | None]:
         """Under the lock: everything queued, with the timing message in front when one is due."""
         batch, self._outbox = self._outbox, []
-        if self._async:
+        self._token += 1
+        if batch:
+            self._unconfirmed.append((self._token, batch))
+        if self._async:  # every batch asks for the DB's confirmation: a timing message carrying the token
             now = _time.monotonic()
-            if now - self._last_timing >= TIMING_PERIOD_S:
+            if now - self._last_timing >= TIMING_PERIOD_S:  # the once-a-second one also measures the skew
                 self._last_timing = now
-                timing = MoosMessage(TIMING, DOUBLE, key=TIMING_KEY, msg_time=self._clock.local_time(), dval=0.0)
-                batch.insert(0, encode_message(timing))
+                self._skew_token = self._token
+            timing = MoosMessage(TIMING, DOUBLE, msg_id=self._token, key=TIMING_KEY,
+                                 msg_time=self._clock.local_time(), dval=0.0)
+            batch = [encode_message(timing), *batch]
         if self._space_waiters:
             self._cond.notify_all()
         return batch, self._conn
@@ -219,7 +243,7 @@ class ClientEngine:
         """Write until the outbox is empty; the caller has set ``_busy``."""
         while True:
             with self._lock:
-                if not self._outbox or self._conn is None or not self._live:
+                if not self._outbox or self._conn is None or not self._writable:
                     self._busy = False
                     self._last_write = _time.monotonic()
                     if self._space_waiters:
@@ -250,7 +274,7 @@ class ClientEngine:
         while not self._stop.is_set():
             with self._lock:
                 timing_due = self._last_timing + TIMING_PERIOD_S - _time.monotonic()
-                if self._busy or not self._live or (not self._outbox and timing_due > 0):
+                if self._busy or not self._writable or (not self._outbox and timing_due > 0):
                     self._writer_waiting = True
                     self._cond.wait(min(WRITER_IDLE_WAKE_S, max(timing_due, 0.001)))
                     self._writer_waiting = False
@@ -315,6 +339,9 @@ class ClientEngine:
         log.info("%s: connected to %s:%d (community %r)", self._name, self._host, self._port, self._community)
         self._reregister()
         self._run_callback(self._on_connect, "on-connect")
+        with self._lock:  # what was queued while down, or by on-connect, goes now: after the re-registrations
+            self._writable = True
+            self._cond.notify_all()
         self._reregistered = set()  # only on-connect's repeats of the automatic registrations are skipped
         try:
             if self._async:
@@ -332,17 +359,41 @@ class ClientEngine:
     def _disconnected(self, conn: PacketSocket) -> None:
         with self._lock:
             was_connected = self._live
-            self._live = False
+            self._live = self._writable = False
             self._connected.clear()
             self._conn = None
             self._bytes_sent_total += conn.bytes_sent
             self._bytes_read_total += conn.bytes_read
+            in_doubt = [batch for _, batch in self._unconfirmed]
+            self._unconfirmed.clear()
             self._cond.notify_all()
         conn.close()
+        if in_doubt:
+            log.warning("%s: %d message(s) written but not confirmed by the DB when the connection was lost; "
+                        "reported undelivered", self._name, sum(map(len, in_doubt)))
+            self._report_undelivered(in_doubt)
         if self._outbox and not self._stop.is_set():
             log.info("%s: %d queued message(s) will be sent after reconnecting", self._name, len(self._outbox))
         if was_connected:
             self._run_callback(self._on_disconnect, "on-disconnect")
+
+    def _confirm(self, token: int | None) -> None:
+        """The DB has processed every batch up to ``token`` (None: everything written)."""
+        with self._lock:
+            unconfirmed = self._unconfirmed
+            while unconfirmed and (token is None or unconfirmed[0][0] <= token):
+                unconfirmed.popleft()
+
+    def _report_undelivered(self, batches: Iterable[list[bytes]]) -> None:
+        """Count and hand over messages that were accepted but may not have reached the DB."""
+        messages = [m for batch in batches for m in PacketReader().feed(frame_packet(batch))[0]]
+        self._undelivered += len(messages)
+        func = self._on_undelivered
+        if func is not None and messages:
+            try:
+                func(messages)
+            except Exception:
+                log.exception("%s: on-undelivered callback raised; carrying on", self._name)
 
     def _run_callback(self, func: Callback | None, what: str) -> None:
         if func is None:
@@ -358,7 +409,8 @@ class ClientEngine:
                 self._packets_read += 1
                 if packet and packet[0].msg_type == TIMING:
                     timing = packet.pop(0)
-                    if self._packets_read > 1 and self._correct_time:
+                    self._confirm(timing.msg_id)
+                    if self._packets_read > 1 and self._correct_time and timing.msg_id == self._skew_token:
                         self._clock.update_skew(timing.msg_time, timing.dval, self._clock.local_time())
                     self._out_delay = max(0.0, timing.dval2)
                 elif packet and packet[0].msg_type == NULL_MSG and self._correct_time:
@@ -373,6 +425,8 @@ class ClientEngine:
             with self._lock:
                 batch, self._outbox = self._outbox, []
                 self._busy = bool(batch)
+                if batch:
+                    self._unconfirmed.append((0, batch))
                 self._cond.notify_all()
             if not batch:
                 batch = [encode_message(MoosMessage(NULL_MSG, DOUBLE, src=self._src))]
@@ -382,6 +436,7 @@ class ClientEngine:
                 self._busy = False
                 self._cond.notify_all()
             reply = conn.read_packet()
+            self._confirm(None)  # one reply per packet: the DB has processed what we wrote
             rx = self._clock.local_time()
             self._packets_read += 1
             if reply and reply[0].msg_type == NULL_MSG:

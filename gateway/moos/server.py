@@ -377,6 +377,9 @@ class MoosDB:
             out.extend(db.take_mail(client.name))
             out.extend(encode_message(m) for m in replies)
         if out:
+            # Others' mail from this packet goes out before this reply: a client that sees its packet confirmed
+            # (the echoed timing message or the sync reply) knows the mail already left the DB.
+            self._push_waiting_mail()
             self._send(client, frame_packet(out))
 
     def _response_delay(self, name: bytes) -> float:

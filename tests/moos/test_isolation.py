@@ -117,6 +117,7 @@ def test_good_clients_unaffected_by_slow_readers_and_partial_packets(tmp_path: P
         with connected_comms(db.port, "alice", ["SEQ_B"]) as alice, connected_comms(db.port, "bob", ["SEQ_A"]) as bob:
             rss_start = rss(pid)
             arrivals: dict[str, list[tuple[float, int]]] = {"SEQ_A": [], "SEQ_B": []}
+            sent_at = [0.0] * PER_CLIENT
             peak = [rss_start]
             done = threading.Event()
 
@@ -139,6 +140,7 @@ def test_good_clients_unaffected_by_slow_readers_and_partial_packets(tmp_path: P
                 for t in threads:
                     t.start()
                 for i in range(PER_CLIENT):  # 1,000 a second each, in bursts of 10 every 10 ms
+                    sent_at[i] = time.monotonic()
                     assert alice.notify("SEQ_A", float(i))
                     assert bob.notify("SEQ_B", float(i))
                     if i % 10 == 9:
@@ -151,15 +153,21 @@ def test_good_clients_unaffected_by_slow_readers_and_partial_packets(tmp_path: P
             rss_end = rss(pid)
 
         log = db.log_path.read_text()
+        worst = {}
         for key, got in arrivals.items():
             assert [n for _, n in got] == list(range(PER_CLIENT)), f"{key}: lost or reordered"
-            gaps = [b[0] - a[0] for a, b in zip(got, got[1:])]
-            assert max(gaps) < 0.2, f"{key}: a gap of {max(gaps) * 1000:.0f} ms between good messages"
+            # A gap the DB caused is a growth of latency between consecutive messages; one the sender caused
+            # (this process starved of CPU on a loaded machine) is not, so it is measured against send times.
+            latency = [t - sent_at[n] for t, n in got]
+            gaps = [b - a for a, b in zip(latency, latency[1:])]
+            worst[key] = max(gaps)
+            assert max(gaps) < 0.2, f"{key}: the DB held good messages back {max(gaps) * 1000:.0f} ms"
         assert attack.slow >= 10 and attack.partial >= 5
         assert "not keeping up: outbox full" in log and "slow" in log
         assert "max_buffered_bytes" in log and "partial" in log
         assert "pausing" not in log
-        print(f"max gaps {[round(max(b[0] - a[0] for a, b in zip(g, g[1:])) * 1000) for g in arrivals.values()]} ms, "
+        print(f"max gaps {[round(max(b[0] - a[0] for a, b in zip(g, g[1:])) * 1000) for g in arrivals.values()]} ms "
+              f"(caused by the DB {[round(w * 1000) for w in worst.values()]} ms), "
               f"RSS {rss_start >> 20} -> peak {peak[0] >> 20} -> end {rss_end >> 20} MiB, slow {attack.slow}, partial {attack.partial}")
         assert peak[0] - rss_start < TOTAL_CAP + RSS_SLACK, (rss_start, peak[0])
         assert rss_end - rss_start < TOTAL_CAP, (rss_start, rss_end)  # given back: well under the cap
