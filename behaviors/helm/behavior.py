@@ -92,7 +92,6 @@ class Behavior(ABC):
         self._run_time = 0.0
         self._idle_time = 0.0
         self._last_state_time: float | None = None
-        self._ctr = 0
 
     # ---- configuration -------------------------------------------------------------------------
     def set_param(self, param: str, value: str) -> None:
@@ -235,24 +234,17 @@ class Behavior(ABC):
     def post_flags(self, kind: str, repeatable: bool = True) -> None:
         if not self.flags[kind]:
             return
-        macros = self.macros()
+        macros = self.flag_macros()
         for flag in self.flags[kind]:
             if flag.condition is None or flag.condition.evaluate(self.info.get):
                 self.post(flag.var, flag.value(macros), repeatable=repeatable)
 
-    def macros(self) -> dict[str, Value]:
-        """Flag macros; subclasses add their own (``NX``, ``CX``...)."""
-        self._ctr += 1
-        values: dict[str, Value] = {
-            "OWNSHIP": self.ownship, "BHVNAME": self.name, "BHVTYPE": self.TYPE, "PWT": self.pwt,
-            "UTC": self.now, "NOW": self.now, "CTR": float(self._ctr),
-            "DUR_RUN_TIME": self._run_time, "DUR_IDLE_TIME": self._idle_time,
-        }
-        for macro, var in (("OSX", "NAV_X"), ("OSY", "NAV_Y"), ("OSH", "NAV_HEADING"), ("OSV", "NAV_SPEED")):
-            value = self.info.get_double(var)
-            if value is not None:
-                values[macro] = value
-        return values
+    def flag_macros(self) -> dict[str, str]:
+        """The macros of pHelmIvP 19.8.1's ``IvPBehavior::postFlags``: these four, bracket form only (``$[CONTACT]``
+        is empty outside contact behaviours); every other macro in a run/idle/active/inactive/end flag posts as
+        written, as 19.8.1 posts it."""
+        return {"$[OWNSHIP]": self.ownship, "$[BHVNAME]": self.name, "$[BHVTYPE]": self.TYPE,
+                "$[CONTACT]": str(getattr(self, "contact", ""))}
 
     def set_complete(self) -> None:
         """Post the endflags; a non-perpetual behaviour is then completed (and removed by the engine)."""

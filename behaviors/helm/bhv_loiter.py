@@ -7,7 +7,6 @@ import math
 from .behavior import Behavior, parse_bool, parse_float
 from .errors import ParamError
 from .geometry import Polygon, fmt_num, rel_ang, segment_angle
-from .info_buffer import Value
 from .ivp import ObjectiveFunction, zaic_peak
 from .point_strings import parse_point, parse_polygon
 from .waypoint_engine import WaypointEngine
@@ -156,14 +155,6 @@ class LoiterBehavior(Behavior):
                                   f"center_activate={str(self.center_activate).lower()},"
                                   f"desired_speed={fmt_num(self.desired_speed())},"
                                   f"polygon=\"{self.polygon.spec()}\"", repeatable=True)
-
-    def macros(self) -> dict[str, Value]:
-        values = super().macros()
-        if self.polygon is not None:
-            cx, cy = self.polygon.center()
-            values.update(PTS=self.polygon.spec(), CX=cx, CY=cy, CENTER=f"x={fmt_num(cx)},y={fmt_num(cy)}",
-                          CWISE=str(self.clockwise).lower(), RAD=self.polygon.max_radius())
-        return values
 
     # ---- states --------------------------------------------------------------------------------
     def on_idle_state(self) -> None:

@@ -8,7 +8,6 @@ from .behavior import Behavior, parse_bool, parse_float
 from .errors import ParamError
 from .flags import Flag
 from .geometry import Point, fmt_num, perp_on_segment, project, rel_ang
-from .info_buffer import Value
 from .ivp import ObjectiveFunction, zaic_peak
 from .point_strings import parse_point, parse_seglist
 from .waypoint_engine import WaypointEngine
@@ -149,27 +148,18 @@ class WaypointBehavior(Behavior):
         self.post("BHV_SETTINGS", f"type=BHV_Waypoint,name={self.name},points={pts},speed={fmt_num(self.speed, 1)}",
                   repeatable=True)
 
-    # ---- macros --------------------------------------------------------------------------------
-    def macros(self) -> dict[str, Value]:
-        values = super().macros()
-        eng = self.engine
-        if eng.points:
-            nx, ny = eng.target
-            values.update(NI=float(eng.index), NX=nx, NY=ny, X=nx, Y=ny, IX=float(eng.index))
-        prev = self._prevpt
-        if prev is not None:
-            values.update(PX=prev[0], PY=prev[1], PI=float(max(eng.index - 1, 0)))
-        values.update(CYCLES=float(eng.cycle_count), WPTS_HIT=float(eng.total_hits),
-                      WPTS=float(len(eng.points)), SPEED=self.speed, SPEED_ALT=self.speed_alt,
-                      WPTS_REM=float(max(len(eng.points) - eng.index, 0)),
-                      POINTS=":".join(f"{fmt_num(x)},{fmt_num(y)}" for x, y in eng.points))
-        return values
-
-    def _post_wpt_flags(self) -> None:
-        macros = self.macros()
+    # ---- flags ---------------------------------------------------------------------------------
+    def _post_wpt_flags(self, reached: Point, nxt: Point) -> None:
+        """pHelmIvP 19.8.1's ``postWptFlags(x, y)``: ``$(X)``/``$(Y)`` (or ``$[X]``/``$[Y]``) are the waypoint just
+        reached, ``$(NX)``/``$(NY)`` (or bracketed) the next one, at most 2 decimals; nothing else is expanded
+        (``$(PX)``, ``$(NI)``, ``$[OWNSHIP]``... post as written). Posted every time (repeatable). On completion
+        both are the last waypoint (19.8.1 posts the engine's point and leaves its next point as it was)."""
+        xs, ys, nxs, nys = (fmt_num(v, 2) for v in (*reached, *nxt))
+        macros = {"$(X)": xs, "$(Y)": ys, "$[X]": xs, "$[Y]": ys,
+                  "$(NX)": nxs, "$(NY)": nys, "$[NX]": nxs, "$[NY]": nys}
         for flag in self.wpt_flags:
             if flag.condition is None or flag.condition.evaluate(self.info.get):
-                self.post(flag.var, flag.value(macros))
+                self.post(flag.var, flag.value(macros), repeatable=True)
 
     # ---- states --------------------------------------------------------------------------------
     def on_run_to_idle_state(self) -> None:
@@ -196,14 +186,13 @@ class WaypointBehavior(Behavior):
         hit = result in ("advanced", "cycled", "completed")
         if result in ("completed", "cycled"):
             self.post(self.var_status + self.suffix, f"behavior-name={self.name},{result}")
-            macros = self.macros()
-            for flag in self.cycle_flags:
+            for flag in self.cycle_flags:  # 19.8.1's postCycleFlags: posted as written, no macro expanded
                 if flag.condition is None or flag.condition.evaluate(self.info.get):
-                    self.post(flag.var, flag.value(macros), repeatable=True)
+                    self.post(flag.var, flag.value({}), repeatable=True)
         if (eng.target != this_pt or hit or (self.wptflag_on_start and not self._wpt_flag_published)
                 or result == "completed"):
             self._prevpt = this_pt
-            self._post_wpt_flags()
+            self._post_wpt_flags(this_pt, this_pt if result == "completed" else eng.target)
             self._wpt_flag_published = True
         if eng.cycle_count != self._last_cycles and self.var_cycle.lower() != "silent":
             self.post(self.var_cycle + self.suffix, float(eng.cycle_count))

@@ -1,16 +1,13 @@
-"""Flags (``endflag = RETURN = true``) and the ``$[MACRO]`` / ``$(MACRO)`` expansion done when they post."""
+"""Flags (``endflag = RETURN = true``) and the macro replacement done when they post (pHelmIvP 19.8.1's rules)."""
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 from .errors import ParamError
-from .geometry import fmt_num
 from .logic import LogicCondition, is_number
 
-_MACRO = re.compile(r"\$[\[(]([A-Za-z0-9_]+)[\])]")
 Value = float | str
 
 
@@ -39,25 +36,20 @@ class Flag:
             raise ParamError(f"flag '{spec}': expected VAR = value")
         return cls(var, value.strip(), condition)
 
-    def value(self, macros: Mapping[str, Value]) -> Value:
-        """The value to post: macros expanded; a number (or a lone macro that is one) posts as a double."""
+    def value(self, macros: Mapping[str, str]) -> Value:
+        """The value to post, as pHelmIvP 19.8.1's ``VarDataPair(var, value, "auto")``: a number posts as a double
+        (nothing expanded), a quoted text without its quotes, and text has exactly the ``macros`` tokens replaced
+        (MBUtils' findReplace, in order); any other ``$[..]``/``$(..)`` posts as written, as 19.8.1 does."""
         text = self.text
-        lone = _MACRO.fullmatch(text)
-        if lone and isinstance(macros.get(lone.group(1)), float):
-            return float(macros[lone.group(1)])  # type: ignore[arg-type]
-        expanded = expand(text, macros)
-        if len(expanded) >= 2 and expanded[0] == '"' and expanded[-1] == '"':
-            return expanded[1:-1]
-        return float(expanded) if is_number(expanded) else expanded
+        if is_number(text):
+            return float(text)
+        if len(text) >= 2 and text[0] == '"' and text[-1] == '"':
+            text = text[1:-1]
+        return expand(text, macros)
 
 
-def expand(text: str, macros: Mapping[str, Value]) -> str:
-    """Replace every known ``$[X]`` / ``$(X)``; doubles print with up to 3 decimals; unknown ones stay."""
-
-    def one(match: re.Match[str]) -> str:
-        value = macros.get(match.group(1))
-        if value is None:
-            return match.group(0)
-        return fmt_num(value) if isinstance(value, float) else str(value)
-
-    return _MACRO.sub(one, text)
+def expand(text: str, macros: Mapping[str, str]) -> str:
+    """Replace each literal token (``"$[OWNSHIP]"``) by its text, in order; nothing else is touched."""
+    for token, replacement in macros.items():
+        text = text.replace(token, replacement)
+    return text

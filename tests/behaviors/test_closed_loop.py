@@ -34,7 +34,7 @@ Behavior = BHV_Waypoint
 {
   name      = survey
   condition = DEPLOY = true
-  wptflag   = ARRIVED = $(PX),$(PY)
+  wptflag   = ARRIVED = $(X),$(Y):$(PX),$(PY)
   endflag   = DONE = true
   speed     = 2.0
   capture_radius = 5
@@ -64,7 +64,9 @@ def test_park_then_waypoints_in_order_within_capture_radius(tmp_path: Path) -> N
     start = next(t for t, n, v, _ in obs.mail if n == "IVPHELM_STATE" and v == "DRIVE")
     duration = next(t for t, n, _, _ in obs.mail if n == "DONE") - start
     assert obs.values("WPT_INDEX") == [0.0, 1.0, 2.0, 3.0]
-    assert obs.values("ARRIVED") == ["40,0", "40,50", "-20,50", "-20,10"]
+    # pHelmIvP 19.8.1's postWptFlags: $(X),$(Y) the waypoint reached (the last one again on completion);
+    # $(PX)/$(PY) are later releases' macros and post as written (test_phelmivp_compare checks it against 19.8.1)
+    assert obs.values("ARRIVED") == [f"{p}:$(PX),$(PY)" for p in ("40,0", "40,50", "-20,50", "-20,10")]
     assert obs.last("WPT_STAT") == "behavior-name=survey,completed"
     # each point was reached within the capture radius, in order
     times = []

@@ -48,7 +48,7 @@ def test_park_until_override_then_drive_and_allstop_postings(tmp_path: Path) -> 
     # nothing active: NothingToDo twice (one-iteration grace), then one set of zeros
     assert loop.values("IVPHELM_ALLSTOP") == ["ManualOverride", "NothingToDo", "NothingToDo"]
     assert loop.values("DESIRED_SPEED") == [0.0, 0.0]
-    assert loop.values("IDLE_SEEN") == ["true"] and loop.values("CRUISE_SPD") == [2.0]
+    assert loop.values("IDLE_SEEN") == ["true"] and loop.values("CRUISE_SPD") == ["$[SPEED]"]
     loop.poke("DEPLOY", "true")
     loop.run(2)
     assert loop.values("IVPHELM_ALLSTOP")[-1] == "clear"
@@ -73,9 +73,10 @@ def test_waypoints_reached_in_order_then_endflags(tmp_path: Path) -> None:
     loop = CoreLoop(make_helm(tmp_path, WAYPOINTS, start_engaged="true"))
     loop.poke("DEPLOY", "true")
     assert loop.run(300, until=lambda: loop.values("RETURN"))
-    assert loop.values("NEXT") == ["60,60", "60,0", "0,60"]  # on each advance (no wptflag_on_start)
+    # on each advance (no wptflag_on_start) and at completion, where 19.8.1's next point is still the last one
+    assert loop.values("NEXT") == ["60,60", "60,0", "60,0"]
     assert loop.values("WPT_INDEX") == [0.0, 1.0, 2.0]
-    assert loop.values("SUMMARY") == ["speed=2"]
+    assert loop.values("SUMMARY") == ["speed=$[SPEED]"]  # 19.8.1 expands only OWNSHIP/BHVNAME/BHVTYPE/CONTACT
     assert loop.last("WPT_STAT") == "behavior-name=survey,completed"
     # each waypoint was passed within the slip radius, and the capture radius held for most
     for px, py in [(0, 60), (60, 60), (60, 0)]:

@@ -78,7 +78,7 @@ Behavior = BHV_Waypoint
   slip_radius = 0
   order = reverse
   repeat = 1
-  wptflag = HIT = $(PX),$(PY)
+  wptflag = HIT = $(X),$(Y):$(PX),$(PY)
   cycleflag = CYCLED = $[CYCLES]
   endflag = END = true
   points = 0,30:30,30
@@ -89,8 +89,9 @@ Behavior = BHV_Waypoint
 def test_reverse_order_and_one_repeat(tmp_path: Path) -> None:
     loop = CoreLoop(make_helm(tmp_path, REPEAT, start_engaged="true"))
     assert loop.run(400, until=lambda: loop.values("END"))
-    assert loop.values("HIT") == ["30,30", "0,30", "30,30", "0,30"]
-    assert loop.values("CYCLED") == [1.0, 2.0]
+    # pHelmIvP 19.8.1: $(X),$(Y) is the waypoint reached; $(PX)/$(PY) and cycle flags are not expanded
+    assert loop.values("HIT") == ["30,30:$(PX),$(PY)", "0,30:$(PX),$(PY)", "30,30:$(PX),$(PY)", "0,30:$(PX),$(PY)"]
+    assert loop.values("CYCLED") == ["$[CYCLES]", "$[CYCLES]"]
     assert loop.values("WPT_STAT").count("behavior-name=w,cycled") == 1
     assert loop.last("WPT_STAT") == "behavior-name=w,completed"
     assert loop.helm.engine.behaviors[0].name == "w"  # repeat > 0 made it perpetual: it stays
