@@ -17,11 +17,10 @@ from launch.trail.generate_all_launch import DEFAULT_N_AUVS
 # (interface file stem, application it merges into or None) per platform kind
 PLATFORM_INTERFACES: dict[str, list[tuple[str, str | None]]] = {
     "topside": [("topside-manager", None), ("trail-mission-operator", None)],
+    # frontseat-interface's file includes the FrontSeatTranslation it runs (its moos_helm block), as Goby's does
     "usv": [("usv-manager", None), ("frontseat-interface", None),
-            ("moos-gateway-frontseat-plugin", "frontseat-interface"),
             ("moos-gateway-goby3-course-plugin", "moos-gateway"), ("goby-helm-example", None)],
     "auv": [("auv-manager", None), ("frontseat-interface", None),
-            ("moos-gateway-frontseat-plugin", "frontseat-interface"),
             ("moos-gateway-goby3-course-plugin", "moos-gateway")],
 }
 
