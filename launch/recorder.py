@@ -135,6 +135,7 @@ class PortalRecorder:
         self._cfg.app.name = "usv-demo-recorder"
         self._cfg.interprocess.platform = platform
         self._cfg.interprocess.socket_name = ipc_base
+        self._cfg.interprocess.manager_timeout_seconds = 30  # a loaded machine's broker can be slow to answer
         self._record = record
         self._clock = clock
         self._listener: _PortalListener | None = None

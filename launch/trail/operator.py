@@ -98,6 +98,7 @@ class PortalWorker:
         self._cfg.app.simulation.time.reference_microtime = 0
         self._cfg.interprocess.platform = platform
         self._cfg.interprocess.socket_name = ipc_base
+        self._cfg.interprocess.manager_timeout_seconds = 30
         self._jobs: queue.Queue[Callable[[SimpleThread], None]] = queue.Queue()
         self._worker: _Worker | None = None
         self._lock = threading.Lock()
