@@ -197,3 +197,26 @@ def test_generated_goby_configs_use_only_goby3_fields(tmp_path: Path) -> None:
     assert len(configs) >= 4
     problems = [p for where, cfg in configs for p in goby_field_problems(cfg, where)]
     assert not problems, "\n".join(problems)
+
+
+def test_the_recording_tool_reads_descriptors_as_the_committed_file_has_them() -> None:
+    # our AppConfig and basic simulator config are now exactly Goby's: recorded by the tool's own code, they must
+    # come out as the committed data file has Goby3's (the tool itself needs a Goby3 clone, not available in CI)
+    from frontseat.protobuf import basic_simulator_config_pb2
+    from gateway.goby.protobuf import app_config_pb2
+    from tools.goby_field_set import dump, field_set
+
+    files = descriptor_pb2.FileDescriptorSet()
+    for module, goby_path in ((app_config_pb2, "goby/middleware/protobuf/app_config.proto"),
+                              (basic_simulator_config_pb2,
+                               "goby/middleware/frontseat/simulator/basic/basic_simulator_frontseat_driver_config.proto")):
+        fd = files.file.add()
+        module.DESCRIPTOR.CopyToProto(fd)
+        fd.name = goby_path
+    recorded = field_set(files, "test")
+    assert json.loads(dump(recorded)) == recorded
+    for name in ("goby.middleware.protobuf.AppConfig", "goby.middleware.protobuf.AppConfig.SimulatorSettings.Time",
+                 "goby.middleware.frontseat.protobuf.BasicSimulatorFrontSeatConfig.StartParams.VehicleConfig"):
+        assert recorded["messages"][name] == MESSAGES[name], name
+    ext = [e for e in recorded["extensions"] if e["name"].endswith("basic_simulator_config")]
+    assert ext == [EXTENSIONS[("goby.middleware.frontseat.protobuf.Config", 1001)]]

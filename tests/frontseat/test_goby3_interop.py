@@ -45,6 +45,9 @@ def test_real_interface_and_simulator_reach_command_with_our_moos_side(tmp_path:
         path.write_text(generate(app, settings))
     mission = generate("moos", settings)  # writes the .moos file, returns its path
     interprocess = text_format.Parse(configs["broker"].read_text(), GobyDaemonConfig()).interprocess
+    # Goby's generated wrapper sets LD_LIBRARY_PATH and the driver library; without it, name the library ourselves
+    wrapper = shutil.which("goby_frontseat_interface_basic_simulator")
+    interface = [wrapper] if wrapper else ["goby_frontseat_interface"]
     fs_env = dict(os.environ, FRONTSEAT_DRIVER_LIBRARY=f"libgoby_frontseat_basic_simulator.so.{GOBY_SOVERSION}")
     gw_env = dict(os.environ, GOBY_MOOS_GATEWAY_PLUGINS="translators.usv.command_translation")
     commands = [
@@ -52,7 +55,7 @@ def test_real_interface_and_simulator_reach_command_with_our_moos_side(tmp_path:
         ([str(BIN / "goby-broker"), str(configs["broker"])], None),
         ([str(BIN / "moos-db"), mission], None),
         ([str(BIN / "ivp-helm"), mission], None),
-        (["goby_frontseat_interface", str(configs["frontseat_interface"])], fs_env),
+        ([*interface, str(configs["frontseat_interface"])], fs_env),
         ([str(BIN / "moos-gateway"), str(configs["moos_gateway"])], gw_env),
     ]
     procs: list[AppProcess] = []
