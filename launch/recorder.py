@@ -124,6 +124,8 @@ class _PortalListener(SimpleThread):
     def _on_ack(self, ack: Any) -> None:
         stage = ack.DESCRIPTOR.fields_by_name["stage"].enum_type.values_by_number[ack.stage].name
         posts = ";".join(ack.moos_post)
+        if stage.startswith("LINK_"):  # the satellite link's ack (or expiry), sim seconds
+            posts = f"slot_wait={ack.slot_wait:.2f};link_latency={ack.link_latency:.2f}"
         self._record.add_event(self._clock.now(), "ack", stage, posts or ack.error, ack.responder)
 
 

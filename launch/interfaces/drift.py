@@ -13,7 +13,8 @@ from collections.abc import Iterable
 from gateway.goby.portal.interface_registry import InterfaceEntry
 from launch.interfaces.model import ApplicationInterface
 
-INTERNAL_GROUP_PREFIXES = ("goby::zeromq::_internal", "goby::middleware::interprocess::")
+INTERNAL_GROUP_PREFIXES = ("goby::zeromq::_internal", "goby::middleware::interprocess::",
+                           "goby::middleware::intervehicle::")  # transport internals (intervehicle diagnostics)
 _DIRECTION = {"publish": "publishes", "subscribe": "subscribes"}
 
 

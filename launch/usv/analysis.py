@@ -84,6 +84,29 @@ def command_effects(record: MissionRecord) -> list[CommandEffect]:
     return effects
 
 
+@dataclass(frozen=True)
+class LinkAck:
+    """The satellite link's answer to one shore command (recorded on the topside broker): sim seconds."""
+
+    t: float
+    acked: bool
+    slot_wait: float
+    latency: float
+    responder: str
+
+
+def link_acks(record: MissionRecord) -> list[LinkAck]:
+    """LINK_ACKED / LINK_EXPIRED events, in order (value ``slot_wait=S;link_latency=L``)."""
+    out = []
+    for event in record.snapshot()[1]:
+        if event.source != "ack" or event.name not in ("LINK_ACKED", "LINK_EXPIRED"):
+            continue
+        fields = dict(part.split("=", 1) for part in str(event.value).split(";") if "=" in part)
+        out.append(LinkAck(event.t, event.name == "LINK_ACKED", float(fields.get("slot_wait", "nan")),
+                           float(fields.get("link_latency", "nan")), event.origin))
+    return out
+
+
 @dataclass
 class LoiterPhase:
     """An interval with DEPLOY_STATE=POLYGON and how the vehicle did on the ring in force."""

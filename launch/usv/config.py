@@ -18,6 +18,7 @@ from launch.config import SHARED_TEMPLATES, fail, render, text_format_string
 from launch.errors import MissionConfigError
 from launch.usv.analysis import bhv_loiter_polygon, bhv_waypoints
 from launch.usv.settings import USV_DIR, UsvSettings
+from translators.usv.satellite import TOPSIDE_MODEM_ID, USV_MODEM_ID
 
 TEMPLATES = USV_DIR / "templates"
 
@@ -43,7 +44,23 @@ def _values(settings: UsvSettings, app: str) -> dict[str, object]:
     }
     values["app_block"] = render(SHARED_TEMPLATES / "_app.pb.cfg.in", values)
     values["interprocess_block"] = render(SHARED_TEMPLATES / "_interprocess.pb.cfg.in", values)
+    values["intervehicle_block"] = _satellite_block(settings, USV_MODEM_ID)
     return values
+
+
+def _topside_values(settings: UsvSettings, app: str) -> dict[str, object]:
+    """The values of an app on the topside's own broker (the shore), whose satellite modem is 1."""
+    values = _values(settings, app)
+    values["platform"] = settings.topside_platform
+    values["socket_name"] = settings.topside_ipc_base
+    values["interprocess_block"] = render(SHARED_TEMPLATES / "_interprocess.pb.cfg.in", values)
+    values["intervehicle_block"] = _satellite_block(settings, TOPSIDE_MODEM_ID)
+    return values
+
+
+def _satellite_block(settings: UsvSettings, modem_id: int) -> str:
+    """The broker's intervehicle block: the course's satellite link (topside 1, USV 2; 5 s / 64 B slots)."""
+    return render(TEMPLATES / "_satellite_link.pb.cfg.in", {"modem_id": modem_id, "sat_port": settings.sat_port})
 
 
 def _pb(template: str, app: str) -> Callable[[UsvSettings], str]:
@@ -52,6 +69,19 @@ def _pb(template: str, app: str) -> Callable[[UsvSettings], str]:
         return render(path if path.is_file() else SHARED_TEMPLATES / template, _values(settings, app))
 
     return generate
+
+
+def _topside(template: str, app: str) -> Callable[[UsvSettings], str]:
+    def generate(settings: UsvSettings) -> str:
+        return render(TEMPLATES / template, _topside_values(settings, app))
+
+    return generate
+
+
+def _vehicle_interprocess(settings: UsvSettings) -> str:
+    """The USV broker's interprocess block on one line (the shore watches the vehicle's state there)."""
+    return " ".join(render(SHARED_TEMPLATES / "_interprocess.pb.cfg.in", _values(settings, "usv-shore"))
+                    .replace("interprocess {", "").replace("}", "").split())
 
 
 def _liaison(settings: UsvSettings) -> str:
@@ -96,8 +126,10 @@ GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
     "frontseat_tuning": _pb("frontseat_tuning.pb.cfg.in", "frontseat-interface"),
     "moos_gateway": _pb("moos_gateway.pb.cfg.in", "moos-gateway"),
     "usv_manager": _pb("usv_manager.pb.cfg.in", "usv-manager"),
-    "shore": _pb("shore.pb.cfg.in", "usv-shore"),
-    "usv_command": _pb("shore.pb.cfg.in", "usv-command"),  # for sending commands by hand
+    "topside_broker": _topside("broker.pb.cfg.in", "goby-broker"),
+    "shore": _topside("shore.pb.cfg.in", "usv-shore"),
+    "usv_command": _topside("shore.pb.cfg.in", "usv-command"),  # for sending commands by hand
+    "vehicle_interprocess": _vehicle_interprocess,
     "liaison": _liaison,
     "moos": _moos,
 }
@@ -113,6 +145,7 @@ def generate(app: str, settings: UsvSettings) -> str:
     try:
         settings.run_dir.mkdir(parents=True, exist_ok=True)
         Path(settings.ipc_base).parent.mkdir(parents=True, exist_ok=True)
+        Path(settings.topside_ipc_base).parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise MissionConfigError(f"cannot create the run directory {settings.run_dir}: {exc.strerror or exc}") from exc
     return generator(settings)

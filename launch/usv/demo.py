@@ -22,6 +22,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from gateway.goby.acomms.udp_multicast import random_multicast
 from launch.config import free_tcp_port
 from launch.errors import LaunchError, MissionConfigError
 from launch.usv.analysis import bhv_waypoints, command_effects, loiter_phases, transitions
@@ -124,6 +125,7 @@ def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> 
         helm=choose_program(args.helm, "pHelmIvP", "ivp-helm"),
         schedule=args.schedule,
         socket_name=str(socket_dir / "goby_usv"),
+        sat_port=random_multicast()[1],  # the satellite link's port: not shared with another run on this machine
     )
 
 

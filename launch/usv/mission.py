@@ -59,6 +59,7 @@ class UsvMission:
         self.group: ProcessGroup | None = None
         self.moos: MoosRecorder | None = None
         self.portal: PortalRecorder | None = None
+        self.topside: PortalRecorder | None = None
         self.command_time: float | None = None
         # Set from any thread or a signal handler to end start-up, the wait for COMMAND, or the run.
         self.stop_event = threading.Event()
@@ -87,6 +88,10 @@ class UsvMission:
         self.group.start()
         self.portal = PortalRecorder(self.record, self.clock, self.settings.platform, self.settings.ipc_base)
         self.portal.start()
+        # the shore's broker: the satellite link's acks of the commands (slot wait, ack time)
+        self.topside = PortalRecorder(self.record, self.clock, self.settings.topside_platform,
+                                      self.settings.topside_ipc_base)
+        self.topside.start()
 
     def liaison_urls(self, timeout_s: float = 30.0) -> dict[str, str]:
         """The URLs goby-liaison serves (home, scope, commander, map), read from its ready line in its log."""
@@ -116,8 +121,9 @@ class UsvMission:
         died = self.group.check()
         if died is not None:
             raise ProcessDiedError(died.name, died.returncode, died.log_tail())
-        if self.portal is not None and self.portal.error is not None:
-            raise LaunchError(f"the demo's portal recorder failed: {self.portal.error}")
+        for recorder in (self.portal, self.topside):
+            if recorder is not None and recorder.error is not None:
+                raise LaunchError(f"the demo's portal recorder failed: {recorder.error}")
 
     def poll(self) -> None:
         """File new MOOS mail and check that every process is alive (raises ProcessDiedError)."""
@@ -176,8 +182,9 @@ class UsvMission:
         if self.moos is not None:
             self.moos.poll()
             self.moos.close()
-        if self.portal is not None:
-            self.portal.close()
+        for recorder in (self.portal, self.topside):
+            if recorder is not None:
+                recorder.close()
         ended: list[ProcessOutcome] = []
         errors: list[str] = []
         if self.group is not None:

@@ -41,6 +41,7 @@ _ENV = {
     "socket_name": "USV_SOCKET_NAME",
     "liaison_address": "USV_LIAISON_ADDRESS",
     "liaison_port": "USV_LIAISON_PORT",
+    "sat_port": "USV_SAT_PORT",
 }
 
 
@@ -64,11 +65,13 @@ class UsvSettings:
     socket_name: str = ""
     liaison_address: str = "127.0.0.1"  # goby-liaison's http_address: loopback unless asked (it has no login)
     liaison_port: int = 50001  # the course's liaison port: 50000 + vehicle id
+    sat_port: int = 54500  # the satellite link's UDP multicast port (the course's; 239.142.0.2)
+    topside_platform: str = "topside"  # the shore's own broker (satellite modem 1)
 
     def __post_init__(self) -> None:
         if self.warp < 1:
             raise MissionConfigError(f"warp must be a whole number >= 1, not {self.warp}")
-        for port_name in ("moos_port", "sim_port", "liaison_port"):
+        for port_name in ("moos_port", "sim_port", "liaison_port", "sat_port"):
             port = getattr(self, port_name)
             if not 0 < port < 65536:
                 raise MissionConfigError(f"{port_name} {port} is not a TCP port")
@@ -79,6 +82,11 @@ class UsvSettings:
     def ipc_base(self) -> str:
         """The broker's IPC socket base (``<base>.manager``, ``.xpub``, ``.xsub``), short enough for AF_UNIX."""
         return self.socket_name or str(self.run_dir / f"goby_{self.platform}")
+
+    @property
+    def topside_ipc_base(self) -> str:
+        """The topside broker's IPC socket base, next to the USV's."""
+        return str(Path(self.ipc_base).with_name(f"goby_{self.topside_platform}"))
 
     @property
     def liveness_timeout(self) -> int:

@@ -9,6 +9,7 @@ from launch.usv.analysis import (
     command_effects,
     helm_timeline,
     interface_timeline,
+    link_acks,
     loiter_phases,
     normalized_heading,
     transitions,
@@ -58,6 +59,11 @@ def summary_text(result: MissionResult, waypoints: list[Point]) -> str:
     if acks:
         lines.append(f"  acknowledgements: {len([a for a in acks if a.name == 'POSTED_TO_MOOS'])} posted to MOOS, "
                      f"{len([a for a in acks if a.name == 'REFUSED'])} refused")
+    links = link_acks(record)
+    if links:
+        lines.append("  over the satellite link (5 s / 64 B slots): " + "; ".join(
+            f"t={a.t:.0f} s {'acked' if a.acked else 'EXPIRED'}: slot wait {a.slot_wait:.1f} s, "
+            f"{'ack' if a.acked else 'expired'} after {a.latency:.1f} s" for a in links))
     lines.append("loiter phases (distance to the ring after the vehicle first came within 15 m of it):")
     for phase in loiter_phases(record):
         cx, cy = phase.ring.center

@@ -13,7 +13,9 @@ import frontseat.protobuf.basic_simulator_tuning_pb2 as tuning_pb
 import frontseat.protobuf.moos_helm_frontseat_interface_config_pb2 as moos_helm_pb
 from frontseat.protobuf.frontseat_config_pb2 import Config
 from frontseat.protobuf.frontseat_interface_config_pb2 import FrontSeatInterfaceConfig
+from gateway.goby.acomms.protobuf import udp_multicast_driver_pb2 as udp_multicast_pb
 from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
+from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from gateway.moos.mission_file import MissionFile
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from launch.errors import MissionConfigError
@@ -31,7 +33,9 @@ PB_APPS = {
     "moos_gateway": GobyMOOSGatewayConfig,
     "usv_manager": USVManager,
     "shore": CommandTool,
+    "topside_broker": GobyDaemonConfig,
 }
+TOPSIDE_APPS = {"shore", "topside_broker"}  # on the shore's own broker
 
 
 @pytest.fixture
@@ -46,8 +50,29 @@ def test_every_goby_config_parses_and_agrees_on_warp_origin_and_broker(settings)
         assert cfg.app.simulation.time.use_sim_time, app
         assert cfg.app.simulation.time.warp_factor == 17, app
         assert (cfg.app.geodesy.lat_origin, cfg.app.geodesy.lon_origin) == (41.5, -70.7), app
-        assert cfg.interprocess.platform == "usv", app
-        assert cfg.interprocess.socket_name == settings.ipc_base, app
+        if app in TOPSIDE_APPS:
+            assert cfg.interprocess.platform == "topside", app
+            assert cfg.interprocess.socket_name == settings.topside_ipc_base, app
+        else:
+            assert cfg.interprocess.platform == "usv", app
+            assert cfg.interprocess.socket_name == settings.ipc_base, app
+
+
+def test_topside_and_usv_share_the_course_satellite_link(settings):
+    settings = settings.replace(sat_port=47123)
+    links = {}
+    for app in ("broker", "topside_broker"):
+        cfg = text_format.Parse(generate(app, settings), GobyDaemonConfig())
+        (link,) = cfg.intervehicle.link
+        udp = link.driver.Extensions[udp_multicast_pb.config]
+        assert (udp.multicast_address, udp.multicast_port) == ("239.142.0.2", 47123), app
+        assert [(s.src, s.slot_seconds, s.max_frame_bytes) for s in link.mac.slot] == [(1, 5, 64), (2, 5, 64)]
+        assert link.subnet_mask == 0xFF00
+        links[app] = link.modem_id
+    assert links == {"topside_broker": 1, "broker": 2}
+    assert text_format.Parse(generate("shore", settings), CommandTool()).intervehicle
+    vehicle = text_format.Parse(generate("vehicle_interprocess", settings), InterProcessPortalConfig())
+    assert (vehicle.platform, vehicle.socket_name) == ("usv", settings.ipc_base)
 
 
 def test_frontseat_and_gateway_point_at_the_same_moosdb_and_simulator(settings):

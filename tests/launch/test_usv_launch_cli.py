@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from gateway.goby.intervehicle.testing import random_multicast
 from launch.config import free_tcp_port
 from launch.process_group import child_environment
 from launch.usv.mission import LAUNCH_FILE
@@ -69,7 +70,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
     socket_dir = Path(tempfile.mkdtemp(prefix="usvl-", dir="/tmp"))
     settings = UsvSettings(run_dir=tmp_path / "run", warp=10, moos_port=free_tcp_port(), sim_port=free_tcp_port(),
                            liaison_port=free_tcp_port(), moosdb="moos-db", helm="ivp-helm",
-                           socket_name=str(socket_dir / "goby_usv"))
+                           socket_name=str(socket_dir / "goby_usv"), sat_port=random_multicast()[1])
     env = child_environment() | settings.to_env()
     proc = subprocess.Popen(
         [sys.executable, "-m", "launch.apps.goby_launch", "-d", "200", "--status-period", "1", "-L", str(tmp_path / "logs"),
@@ -78,7 +79,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
     )
     out = OutputReader(proc)
     try:
-        out.wait_for(r"All processes running \(9\)")
+        out.wait_for(r"All processes running \(10\)")
         helm_pid = int(out.wait_for(r"^Launched \((\d+)\) usv\.helm:").group(1))
         os.kill(helm_pid, signal.SIGKILL)
         text = out.finish()
@@ -90,7 +91,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
     assert proc.returncode == 1, text
     assert "usv.helm died unexpectedly (exit status -9)" in text
     pids = [int(p) for p in re.findall(r"^Launched \((\d+)\)", text, flags=re.M)]
-    assert len(pids) == 9
+    assert len(pids) == 10
     assert not any(_alive(pid) for pid in pids), text
     logs = sorted(p.name for p in (tmp_path / "logs").iterdir())
     assert "usv.frontseat-interface.log" in logs and "usv.shore.log" in logs

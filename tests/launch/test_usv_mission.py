@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from gateway.goby.intervehicle.testing import random_multicast
 from gateway.goby.portal.interface_registry import ENV_VAR as REGISTRY_ENV
 from gateway.goby.portal.interface_registry import read_entries
 from gateway.moos.testing import real_moos_skip_reason
@@ -24,6 +25,7 @@ from launch.usv.analysis import (
     command_effects,
     helm_timeline,
     interface_timeline,
+    link_acks,
     loiter_phases,
     waypoint_approach,
 )
@@ -50,6 +52,7 @@ def run_mission(run_dir: Path, moosdb: str, helm: str) -> MissionResult:
         helm=helm,
         schedule=SCHEDULE,
         socket_name=str(socket_dir / "goby_usv"),
+        sat_port=random_multicast()[1],  # the satellite link: a port no parallel run shares
     )
     lines: list[str] = []
     mission = UsvMission(settings, report=lines.append)
@@ -101,6 +104,13 @@ def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm, monkeypatch):
     assert second.polygon_before_state, report
     assert "radius=400" in second.posts[0].value and "pts=8" in second.posts[0].value, report
 
+    # Each reached the USV over the satellite link: acked once, within a 10 s (sim) cycle of slots.
+    links = link_acks(record)
+    assert [a.acked for a in links] == [True, True, True], report
+    # (the ack is sent at once by the USV's modem: it follows the slot within the delivery time, a few sim seconds)
+    assert all(0 <= a.slot_wait <= 10.5 and a.slot_wait <= a.latency <= a.slot_wait + 5 for a in links), report
+    assert all(a.responder == "satellite modem 2" for a in links), report
+
     # It converged on the hexagon of radius 200 before the waypoints command.
     phases = loiter_phases(record)
     assert len(phases) == 2, report
@@ -123,7 +133,7 @@ def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm, monkeypatch):
     assert octagon.mean_distance < 15.0, report
 
     # Every process stopped cleanly and no log holds an unexpected error.
-    assert len(result.outcomes) == 9, report
+    assert len(result.outcomes) == 10, report
     assert all(o.clean for o in result.outcomes), report
     assert result.log_errors == [], report
 

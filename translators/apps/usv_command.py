@@ -3,8 +3,14 @@
     usv-command polygon --sides 6 --radius 300 [--timeout 10] [goby options: config file, --interprocess ...]
     usv-command waypoints
 
-Exit codes: 0 acknowledged (posted to MOOS), 1 refused (here, by usv-manager or by CommandTranslation),
-2 bad command line or configuration, 3 no acknowledgement within the timeout.
+Exit codes: 0 acknowledged (posted to MOOS, or with ``intervehicle: true`` acked over the satellite link by the
+USV's modem), 1 refused (here, by usv-manager or by CommandTranslation), 2 bad command line or configuration,
+3 no acknowledgement within the timeout (or expired on the satellite link).
+
+With ``intervehicle: true`` in its config (the topside's broker has the satellite link), the command goes out on
+intervehicle as the course's topside sends it, and the answer is the link's ack, with the slot wait and the ack
+time; otherwise it is published on the shore group of a broker shared with the USV and the answer is usv-manager's
+and CommandTranslation's USVCommandAck.
 """
 
 from __future__ import annotations
@@ -21,6 +27,7 @@ from translators.usv import groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from translators.usv.protobuf.usv_config_pb2 import CommandTool
+from translators.usv.satellite import SatelliteCommander, describe_link_ack
 from translators.usv.validation import DcclBoundsError, check_dccl_bounds
 from util.cli import positive_number
 
@@ -65,6 +72,8 @@ def build_command(args: argparse.Namespace, now: float) -> USVCommand:
 
 def describe_ack(ack: USVCommandAck) -> str:
     """One line for the user about one acknowledgement."""
+    if ack.stage in (USVCommandAck.LINK_ACKED, USVCommandAck.LINK_EXPIRED):
+        return describe_link_ack(ack)
     if ack.stage == USVCommandAck.REFUSED:
         return f"refused by {ack.responder}: {ack.error}"
     if ack.stage == USVCommandAck.RECEIVED_BY_MANAGER:
@@ -81,9 +90,12 @@ class CommandSender(SingleThreadApplication):
         self._command = command
         self._deadline = time.monotonic() + timeout_s
         self._timeout_s = timeout_s
-        self.interprocess().subscribe(groups.usv_command_ack, USVCommandAck, self._on_ack)
-        # Buffered until the broker releases the hold, so it cannot overtake our ack subscription.
-        self.interprocess().publish(groups.shore_usv_command, command)
+        if cfg.intervehicle:
+            SatelliteCommander(self, self._on_ack).send(command)
+        else:
+            self.interprocess().subscribe(groups.usv_command_ack, USVCommandAck, self._on_ack)
+            # Buffered until the broker releases the hold, so it cannot overtake our ack subscription.
+            self.interprocess().publish(groups.shore_usv_command, command)
         print(f"sent: {text_format.MessageToString(command, as_one_line=True)}", flush=True)
 
     def _on_ack(self, ack: USVCommandAck) -> None:
@@ -91,10 +103,12 @@ class CommandSender(SingleThreadApplication):
         if not ack.HasField("command_time") or ack.command_time != self._command.time:
             return  # someone else's command
         print(describe_ack(ack), flush=True)
-        if ack.stage == USVCommandAck.POSTED_TO_MOOS:
+        if ack.stage in (USVCommandAck.POSTED_TO_MOOS, USVCommandAck.LINK_ACKED):
             self.quit(EXIT_ACKNOWLEDGED)
         elif ack.stage == USVCommandAck.REFUSED:
             self.quit(EXIT_REFUSED)
+        elif ack.stage == USVCommandAck.LINK_EXPIRED:
+            self.quit(EXIT_UNACKNOWLEDGED)
 
     def loop(self) -> None:
         """Give up at the deadline. Runs on the main thread at 10 Hz."""

@@ -1,8 +1,9 @@
 """usv-manager: receives USV commands from shore and republishes them on the vehicle's interprocess.
 
-The Goby3 course's goby3_course_usv_manager subscribes to ``usv_command`` on intervehicle (satellite link, with
-ack) and republishes each command on interprocess, where CommandTranslation picks it up. Here shore and vehicle
-share a broker: the shore leg is the group ``goby3_course::shore::usv_command`` (see ``translators.usv.groups``).
+As the Goby3 course's goby3_course_usv_manager, it subscribes to ``usv_command`` on intervehicle (the satellite
+link of the vehicle's goby-broker, from the topside's modem 1, with ack) and republishes each command on interprocess,
+where CommandTranslation picks it up. It also takes commands from a shore sharing the vehicle's broker (the group
+``goby3_course::shore::usv_command``, used by goby-liaison's commander and ``usv-command`` without intervehicle).
 Commands outside their DCCL bounds are refused here, with an acknowledgement that says why, so they never reach
 the vehicle's interprocess.
 """
@@ -24,6 +25,7 @@ from translators.usv import groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from translators.usv.protobuf.usv_config_pb2 import USVManager as USVManagerConfig
+from translators.usv.satellite import TOPSIDE_MODEM_ID, usv_subscriber
 from translators.usv.validation import DcclBoundsError, check_dccl_bounds
 
 log = logging.getLogger(__name__)
@@ -36,7 +38,9 @@ class USVManager(SingleThreadApplication):
         super().__init__(cfg)
         self._subscribe_nav(cfg)  # the course's subscribe_our_nav and subscribe_auv_nav
         self.interprocess().subscribe(groups.shore_usv_command, USVCommand, self._on_shore_command)
-        log.info("waiting for USV commands on %s", groups.shore_usv_command)
+        self.intervehicle().subscribe(groups.usv_command, USVCommand, self._on_shore_command, usv_subscriber())
+        log.info("waiting for USV commands on %s and on intervehicle %s (from satellite modem %d)",
+                 groups.shore_usv_command, groups.usv_command, TOPSIDE_MODEM_ID)
 
     def _on_shore_command(self, command: USVCommand) -> None:
         """Check, republish and acknowledge one command. Runs on the application's main thread."""

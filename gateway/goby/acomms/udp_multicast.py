@@ -11,6 +11,7 @@ from __future__ import annotations
 import errno
 import ipaddress
 import logging
+import random
 import socket
 import struct
 
@@ -22,6 +23,12 @@ from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
 
 log = logging.getLogger(__name__)
 MAX_DATAGRAM = 65535
+
+
+def random_multicast() -> tuple[str, int]:
+    """A multicast group and port unlikely to be used by anything else on the machine (side-by-side runs)."""
+    rng = random.SystemRandom()
+    return f"239.142.{rng.randrange(10, 250)}.{rng.randrange(1, 250)}", rng.randrange(40000, 60000)
 
 
 def multicast_config(cfg: DriverConfig) -> udp_pb.Config:

@@ -103,10 +103,10 @@ class InterVehicleForwarder:
             self._listen()
             self._purge(now_us)
             self._pending[stm_key(stm)] = _Pending(copy, publisher.on_ack, publisher.on_expire, now_us)
-        self._ip.publish(groups.modem_data_out, stm)
+        self._ip.publish(groups.modem_data_out, stm, record=False)
         if grp.name:
-            self._ip.publish(grp, copy, scheme=Scheme.DCCL)
-            self._ip.publish(grp, copy, scheme=Scheme.PROTOBUF)
+            self._ip.publish(grp, copy, scheme=Scheme.DCCL, record=False)
+            self._ip.publish(grp, copy, scheme=Scheme.PROTOBUF, record=False)
 
     # ----------------------------------------------------------------------------------------- subscribe
     def subscribe(self, group: GroupLike, msg_type: type, callback: Callable[[Any], None],
@@ -152,7 +152,7 @@ class InterVehicleForwarder:
         outgoing.CopyFrom(sub)
         if handler is not None:
             outgoing.metadata.CopyFrom(metadata_for(handler.msg_type))
-        self._ip.publish(groups.modem_subscription_forward_tx, outgoing)
+        self._ip.publish(groups.modem_subscription_forward_tx, outgoing, record=False)
 
     def resubscribe(self) -> int:
         """Send every subscription again (the vehicle's broker restarted); returns how many."""
@@ -179,10 +179,10 @@ class InterVehicleForwarder:
         if self._listening:
             return
         self._listening = True
-        self._ip.subscribe(groups.modem_data_in, DCCLForwardedData, self._on_data_in)
-        self._ip.subscribe(groups.modem_ack_in, AckMessagePair, self._on_ack)
-        self._ip.subscribe(groups.modem_expire_in, ExpireMessagePair, self._on_expire)
-        self._ip.subscribe(groups.subscription_report, SubscriptionReport, self._on_report)
+        self._ip.subscribe(groups.modem_data_in, DCCLForwardedData, self._on_data_in, record=False)
+        self._ip.subscribe(groups.modem_ack_in, AckMessagePair, self._on_ack, record=False)
+        self._ip.subscribe(groups.modem_expire_in, ExpireMessagePair, self._on_expire, record=False)
+        self._ip.subscribe(groups.subscription_report, SubscriptionReport, self._on_report, record=False)
 
     def _on_data_in(self, forwarded: DCCLForwardedData) -> None:
         for packet in forwarded.frame:
@@ -206,8 +206,8 @@ class InterVehicleForwarder:
                     log.exception("%s: intervehicle subscriber callback for %s raised; continuing",
                                   self._thread_name, handler.group)
                 if handler.options.republish and handler.group.name:
-                    self._ip.publish(handler.group, msg, scheme=Scheme.PROTOBUF)
-                    self._ip.publish(handler.group, msg, scheme=Scheme.DCCL)
+                    self._ip.publish(handler.group, msg, scheme=Scheme.PROTOBUF, record=False)
+                    self._ip.publish(handler.group, msg, scheme=Scheme.DCCL, record=False)
 
     def _key_of(self, stm: SerializerTransporterMessage) -> StmKey:
         if stm.key.type == Subscription.DESCRIPTOR.full_name:

@@ -3,20 +3,16 @@ with an intervehicle forwarder driven by the test's own thread."""
 
 from __future__ import annotations
 
-import random
 import socket
 import struct
 from collections.abc import Sequence
 
+__all__ = ["IntervehicleClient", "broker_config", "link_block", "loopback_multicast_works", "random_multicast"]
+
+from gateway.goby.acomms.udp_multicast import random_multicast
 from gateway.goby.intervehicle.forwarder import InterVehicleForwarder
 from gateway.goby.portal.testing import PortalClient
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
-
-
-def random_multicast() -> tuple[str, int]:
-    """A multicast group and port unlikely to be used by anything else on the machine (tests run in parallel)."""
-    rng = random.SystemRandom()
-    return f"239.142.{rng.randrange(10, 250)}.{rng.randrange(1, 250)}", rng.randrange(40000, 60000)
 
 
 def loopback_multicast_works(timeout_s: float = 1.0) -> bool:

@@ -129,12 +129,16 @@ class InterProcessPortal:
                   thread_name, self._pub_endpoint, self._sub_endpoint, self._primary)
 
     # ----------------------------------------------------------------------------------------- publish
-    def publish(self, group: GroupLike, msg: Any, *, scheme: int | None = None) -> None:
-        """Serialize ``msg`` and send it to every subscriber of (group, type) in all processes, this one included."""
+    def publish(self, group: GroupLike, msg: Any, *, scheme: int | None = None, record: bool = True) -> None:
+        """Serialize ``msg`` and send it to every subscriber of (group, type) in all processes, this one included.
+
+        ``record=False``: the call is made by a transporter on behalf of another layer (intervehicle), which records
+        its own call; the interface registry does not list it as an interprocess publication.
+        """
         self._check_open()
         group_text = self._group_text(group)
         sch, tname, key = self._type_info(type(msg), scheme)
-        self._publish_frame(group_text, sch, tname, serialize(msg, sch, self._ctx.dccl))
+        self._publish_frame(group_text, sch, tname, serialize(msg, sch, self._ctx.dccl), record)
         self._ctx.interthread.deliver(group_text, key, msg, self._mailbox)
 
     def _group_text(self, group: GroupLike) -> str:
@@ -162,13 +166,14 @@ class InterProcessPortal:
         check_named(grp, "InterProcess")
         self._publish_frame(str(grp), int(scheme), type_name_, payload)
 
-    def _publish_frame(self, group: str, scheme: int, tname: str, payload: bytes) -> None:
+    def _publish_frame(self, group: str, scheme: int, tname: str, payload: bytes, record: bool = True) -> None:
         key = (group, scheme, tname)
         ident = self._identifiers.get(key)
         if ident is None:
             ident = make_identifier(group, scheme, tname, self._pid, self._thread_hex)
             self._identifiers[key] = ident
-            self._record("publish", group, scheme, tname)
+            if record:
+                self._record("publish", group, scheme, tname)
         frame = encode_frame(ident, payload)
         if self._ctx.hold_released:
             if self._held:
@@ -213,17 +218,19 @@ class InterProcessPortal:
     # --------------------------------------------------------------------------------------- subscribe
     def subscribe(
         self, group: GroupLike, msg_type: type, callback: Callable[[Any], None], *, scheme: int | None = None,
-        echo: bool = True,
+        echo: bool = True, record: bool = True,
     ) -> None:
         """Call ``callback(msg)`` on the owning thread for each ``msg_type`` published on ``group`` by any process.
 
-        ``echo=False`` drops this process's own publications (Goby delivers them: the default is ``True``).
+        ``echo=False`` drops this process's own publications (Goby delivers them: the default is ``True``);
+        ``record=False`` as for :meth:`publish`.
         """
         self._check_open()
         group_text = self._group_text(group)
         sch, tname, _ = self._type_info(msg_type, scheme)
         prefix = type_prefix(group_text, sch, tname).encode()
-        self._record("subscribe", group_text, sch, tname)
+        if record:
+            self._record("subscribe", group_text, sch, tname)
         if prefix not in self._subs:
             self._subs[prefix] = []
             self._sub.setsockopt(zmq.SUBSCRIBE, prefix)

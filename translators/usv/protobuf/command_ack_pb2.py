@@ -24,7 +24,7 @@ _sym_db = _symbol_database.Default()
 
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n*translators/usv/protobuf/command_ack.proto\x12\x19goby_moos_py.usv.protobuf\"\xed\x01\n\rUSVCommandAck\x12=\n\x05stage\x18\x01 \x02(\x0e\x32..goby_moos_py.usv.protobuf.USVCommandAck.Stage\x12\x14\n\x0c\x63ommand_time\x18\x02 \x01(\x01\x12\x11\n\tresponder\x18\x03 \x01(\t\x12\r\n\x05\x65rror\x18\x04 \x01(\t\x12\x11\n\tmoos_post\x18\x05 \x03(\t\x12\x0f\n\x07\x63ommand\x18\x06 \x01(\t\"A\n\x05Stage\x12\x17\n\x13RECEIVED_BY_MANAGER\x10\x01\x12\x12\n\x0ePOSTED_TO_MOOS\x10\x02\x12\x0b\n\x07REFUSED\x10\x03')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n*translators/usv/protobuf/command_ack.proto\x12\x19goby_moos_py.usv.protobuf\"\xb8\x02\n\rUSVCommandAck\x12=\n\x05stage\x18\x01 \x02(\x0e\x32..goby_moos_py.usv.protobuf.USVCommandAck.Stage\x12\x14\n\x0c\x63ommand_time\x18\x02 \x01(\x01\x12\x11\n\tresponder\x18\x03 \x01(\t\x12\r\n\x05\x65rror\x18\x04 \x01(\t\x12\x11\n\tmoos_post\x18\x05 \x03(\t\x12\x0f\n\x07\x63ommand\x18\x06 \x01(\t\x12\x11\n\tslot_wait\x18\x07 \x01(\x01\x12\x14\n\x0clink_latency\x18\x08 \x01(\x01\"c\n\x05Stage\x12\x17\n\x13RECEIVED_BY_MANAGER\x10\x01\x12\x12\n\x0ePOSTED_TO_MOOS\x10\x02\x12\x0b\n\x07REFUSED\x10\x03\x12\x0e\n\nLINK_ACKED\x10\x04\x12\x10\n\x0cLINK_EXPIRED\x10\x05')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
@@ -32,7 +32,7 @@ _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'translators.usv.protobuf.co
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
   _globals['_USVCOMMANDACK']._serialized_start=74
-  _globals['_USVCOMMANDACK']._serialized_end=311
-  _globals['_USVCOMMANDACK_STAGE']._serialized_start=246
-  _globals['_USVCOMMANDACK_STAGE']._serialized_end=311
+  _globals['_USVCOMMANDACK']._serialized_end=386
+  _globals['_USVCOMMANDACK_STAGE']._serialized_start=287
+  _globals['_USVCOMMANDACK_STAGE']._serialized_end=386
 # @@protoc_insertion_point(module_scope)

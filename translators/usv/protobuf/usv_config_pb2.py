@@ -26,7 +26,7 @@ from gateway.goby.protobuf import app_config_pb2 as gateway_dot_goby_dot_protobu
 from gateway.goby.protobuf import interprocess_config_pb2 as gateway_dot_goby_dot_protobuf_dot_interprocess__config__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n)translators/usv/protobuf/usv_config.proto\x12\x13goby3_course.config\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\"\xae\x01\n\nUSVManager\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x12\n\nvehicle_id\x18\x0b \x01(\x05\x12\x14\n\x0c\x61uv_modem_id\x18\x14 \x03(\x05\"\x9e\x01\n\x0b\x43ommandTool\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x17\n\x0b\x61\x63k_timeout\x18\n \x01(\x01:\x02\x31\x30')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n)translators/usv/protobuf/usv_config.proto\x12\x13goby3_course.config\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\"\xae\x01\n\nUSVManager\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x12\n\nvehicle_id\x18\x0b \x01(\x05\x12\x14\n\x0c\x61uv_modem_id\x18\x14 \x03(\x05\"\xbb\x01\n\x0b\x43ommandTool\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12\x17\n\x0b\x61\x63k_timeout\x18\n \x01(\x01:\x02\x31\x30\x12\x1b\n\x0cintervehicle\x18\x0b \x01(\x08:\x05\x66\x61lse')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
@@ -36,5 +36,5 @@ if not _descriptor._USE_C_DESCRIPTORS:
   _globals['_USVMANAGER']._serialized_start=156
   _globals['_USVMANAGER']._serialized_end=330
   _globals['_COMMANDTOOL']._serialized_start=333
-  _globals['_COMMANDTOOL']._serialized_end=491
+  _globals['_COMMANDTOOL']._serialized_end=520
 # @@protoc_insertion_point(module_scope)

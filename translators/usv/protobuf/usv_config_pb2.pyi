@@ -21,11 +21,13 @@ class USVManager(_message.Message):
     def __init__(self, app: _Optional[_Union[_app_config_pb2.AppConfig, _Mapping]] = ..., interprocess: _Optional[_Union[_interprocess_config_pb2.InterProcessPortalConfig, _Mapping]] = ..., vehicle_id: _Optional[int] = ..., auv_modem_id: _Optional[_Iterable[int]] = ...) -> None: ...
 
 class CommandTool(_message.Message):
-    __slots__ = ("app", "interprocess", "ack_timeout")
+    __slots__ = ("app", "interprocess", "ack_timeout", "intervehicle")
     APP_FIELD_NUMBER: _ClassVar[int]
     INTERPROCESS_FIELD_NUMBER: _ClassVar[int]
     ACK_TIMEOUT_FIELD_NUMBER: _ClassVar[int]
+    INTERVEHICLE_FIELD_NUMBER: _ClassVar[int]
     app: _app_config_pb2.AppConfig
     interprocess: _interprocess_config_pb2.InterProcessPortalConfig
     ack_timeout: float
-    def __init__(self, app: _Optional[_Union[_app_config_pb2.AppConfig, _Mapping]] = ..., interprocess: _Optional[_Union[_interprocess_config_pb2.InterProcessPortalConfig, _Mapping]] = ..., ack_timeout: _Optional[float] = ...) -> None: ...
+    intervehicle: bool
+    def __init__(self, app: _Optional[_Union[_app_config_pb2.AppConfig, _Mapping]] = ..., interprocess: _Optional[_Union[_interprocess_config_pb2.InterProcessPortalConfig, _Mapping]] = ..., ack_timeout: _Optional[float] = ..., intervehicle: _Optional[bool] = ...) -> None: ...
