@@ -9,7 +9,12 @@ import sys
 import pytest
 from translator_procs import ChildProcess, run_cli, wait_until
 
-from gateway.goby.intervehicle.testing import broker_config, link_block, loopback_multicast_works, random_multicast
+from gateway.goby.intervehicle.testing import (
+    broker_config,
+    link_block,
+    loopback_multicast_works,
+    random_multicast,
+)
 from gateway.goby.portal.testing import BrokerProcess, PortalClient
 from translators.apps.usv_command import EXIT_ACKNOWLEDGED
 from translators.usv import groups as usv_groups
