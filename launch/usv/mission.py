@@ -86,12 +86,27 @@ class UsvMission:
         self.moos.start()
         self.group.on_wait = self.moos.poll
         self.group.start()
+        self._wait_for_brokers()
         self.portal = PortalRecorder(self.record, self.clock, self.settings.platform, self.settings.ipc_base)
         self.portal.start()
         # the shore's broker: the satellite link's acks of the commands (slot wait, ack time)
         self.topside = PortalRecorder(self.record, self.clock, self.settings.topside_platform,
                                       self.settings.topside_ipc_base)
         self.topside.start()
+
+    def _wait_for_brokers(self, timeout_s: float = 120.0) -> None:
+        """Block until both brokers (the USV's, the topside's) have their manager socket: the topside's is launched
+        late, and a portal client gives up if its broker does not answer."""
+        deadline = time.monotonic() + timeout_s
+        sockets = [Path(base + ".manager") for base in (self.settings.ipc_base, self.settings.topside_ipc_base)]
+        while missing := [str(path) for path in sockets if not path.exists()]:
+            if self.stop_event.is_set():
+                return
+            self._check()
+            if time.monotonic() > deadline:
+                raise LaunchError(f"no broker at {', '.join(missing)} within {timeout_s:g} s "
+                                  f"(logs in {self.settings.log_dir})")
+            time.sleep(0.1)
 
     def liaison_urls(self, timeout_s: float = 30.0) -> dict[str, str]:
         """The URLs goby-liaison serves (home, scope, commander, map), read from its ready line in its log."""
