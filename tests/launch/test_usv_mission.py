@@ -107,8 +107,10 @@ def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm, monkeypatch):
     # Each reached the USV over the satellite link: acked once, within a 10 s (sim) cycle of slots.
     links = link_acks(record)
     assert [a.acked for a in links] == [True, True, True], report
-    # (the ack is sent at once by the USV's modem: it follows the slot within the delivery time, a few sim seconds)
-    assert all(0 <= a.slot_wait <= 10.5 and a.slot_wait <= a.latency <= a.slot_wait + 5 for a in links), report
+    # (the ack is sent at once by the USV's modem: it follows the slot within the delivery time; on a loaded machine
+    # a slot may start up to half a real second late, WARP / 2 sim seconds)
+    late = WARP / 2
+    assert all(0 <= a.slot_wait <= 10 + late and a.slot_wait <= a.latency <= a.slot_wait + late for a in links), report
     assert all(a.responder == "satellite modem 2" for a in links), report
 
     # It converged on the hexagon of radius 200 before the waypoints command.

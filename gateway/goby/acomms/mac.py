@@ -31,7 +31,8 @@ class MacManager:
     """Starts our slots; ``on_initiate`` receives a copy of the slot with ``time`` = slot start (µs)."""
 
     def __init__(self, cfg: MACConfig, on_initiate: Callable[[ModemTransmission], None],
-                 on_slot_start: Callable[[ModemTransmission], None] | None = None) -> None:
+                 on_slot_start: Callable[[ModemTransmission], None] | None = None,
+                 allowed_skew_s: float = ALLOWED_SKEW_S) -> None:
         if cfg.type not in (MAC_NONE, MAC_FIXED_DECENTRALIZED):
             name = "MAC_POLLED" if cfg.type == MAC_POLLED else str(cfg.type)
             raise ModemConfigError(f"mac.type {name} is not supported (use MAC_FIXED_DECENTRALIZED or MAC_NONE)")
@@ -39,6 +40,7 @@ class MacManager:
             if slot.slot_seconds <= 0:
                 raise ModemConfigError(f"mac.slot[{i}].slot_seconds must be > 0, got {slot.slot_seconds:g}")
         self.cfg = cfg
+        self.allowed_skew_s = allowed_skew_s
         self._on_initiate = on_initiate
         self._on_slot_start = on_slot_start
         self._index = 0
@@ -86,7 +88,7 @@ class MacManager:
             return
         if now <= self.next_slot_t:
             return
-        if now - self.next_slot_t > ALLOWED_SKEW_S:
+        if now - self.next_slot_t > self.allowed_skew_s:
             self.skipped += 1
             log.warning("MAC for modem %d: slot at %.3f started %.3f s late; skipping it and restarting the cycle",
                         self.cfg.modem_id, self.next_slot_t, now - self.next_slot_t)

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 from gateway.goby.acomms.buffer import BufferNoDataError, DynamicBuffer, Value
 from gateway.goby.acomms.driver import ModemDriver
-from gateway.goby.acomms.mac import MacManager
+from gateway.goby.acomms.mac import ALLOWED_SKEW_S, MacManager
 from gateway.goby.acomms.protobuf.buffer_pb2 import DynamicBufferConfig
 from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
 from gateway.goby.dccl import Codec, DcclError, UnknownIdError
@@ -103,7 +103,8 @@ class Link:
     """The logic of one link; ``now`` is the warped clock in seconds since the epoch."""
 
     def __init__(self, cfg: LinkConfig, driver: ModemDriver, now: Callable[[], float],
-                 outputs: LinkOutputs | None = None, codec: Codec | None = None) -> None:
+                 outputs: LinkOutputs | None = None, codec: Codec | None = None,
+                 allowed_skew_s: float = ALLOWED_SKEW_S) -> None:
         self.cfg = cfg
         self.driver = driver
         self.now = now
@@ -123,7 +124,7 @@ class Link:
         mac_cfg = type(cfg.mac)()
         mac_cfg.CopyFrom(cfg.mac)
         mac_cfg.modem_id = cfg.modem_id
-        self.mac = MacManager(mac_cfg, self._initiate)
+        self.mac = MacManager(mac_cfg, self._initiate, allowed_skew_s=allowed_skew_s)
         driver.signal_data_request.connect(self._data_request)
         driver.signal_receive.connect(self._receive)
         self._started = False

@@ -17,6 +17,7 @@ from collections.abc import Callable
 from gateway.goby.acomms.driver import ModemDriver
 from gateway.goby.acomms.errors import AcommsError, ModemConfigError
 from gateway.goby.acomms.ether import Ether, EtherDriver
+from gateway.goby.acomms.mac import ALLOWED_SKEW_S
 from gateway.goby.acomms.protobuf.driver_base_pb2 import DRIVER_UDP_MULTICAST, DriverConfig
 from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
 from gateway.goby.acomms.udp_multicast import UDPMulticastDriver
@@ -34,6 +35,8 @@ from gateway.goby.portal.thread import SimpleThread
 
 log = logging.getLogger(__name__)
 
+#: Real seconds a slot may start late before it is skipped (besides Goby's 2 s warped).
+REAL_SKEW_S = 0.5
 #: Goby's driver thread loop frequency (warped).
 LINK_LOOP_HZ = 10.0
 #: Real seconds after start at which a link announces itself again (apps then resend their subscriptions).
@@ -72,7 +75,10 @@ class LinkThread(SimpleThread):
             transmitted=lambda m: ip.publish(groups.modem_transmit_result, self._with_id(m)),
             initiated=lambda m: ip.publish(groups.mac_initiate_transmission, self._with_id(m)),
         )
-        self.link = Link(cfg, driver, self.context.clock.now, outputs)
+        # Goby skips a slot started more than 2 s (warped) late; at high warp on a loaded machine that is a few
+        # tens of real milliseconds, so we also allow half a real second (docs/intervehicle.md).
+        skew = max(ALLOWED_SKEW_S, REAL_SKEW_S * self.context.clock.effective_warp)
+        self.link = Link(cfg, driver, self.context.clock.now, outputs, allowed_skew_s=skew)
         ip.subscribe(groups.modem_data_out, SerializerTransporterMessage, self.link.buffer_message)
         ip.subscribe(groups.modem_subscription_forward_tx, Subscription, self.link.forward_subscription)
         ip.subscribe(groups.modem_subscription_forward_rx, Subscription, self.link.accept_subscription)
