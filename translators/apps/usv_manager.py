@@ -1,11 +1,12 @@
-"""usv-manager: receives USV commands from shore and republishes them on the vehicle's interprocess.
+"""usv-manager: USV commands from shore onto the vehicle's interprocess; the USV's and the AUVs' nav out.
 
 As the Goby3 course's goby3_course_usv_manager, it subscribes to ``usv_command`` on intervehicle (the satellite
 link of the vehicle's goby-broker, from the topside's modem 1, with ack) and republishes each command on interprocess,
 where CommandTranslation picks it up. It also takes commands from a shore sharing the vehicle's broker (the group
 ``goby3_course::shore::usv_command``, used by goby-liaison's commander and ``usv-command`` without intervehicle).
 Commands outside their DCCL bounds are refused here, with an acknowledgement that says why, so they never reach
-the vehicle's interprocess.
+the vehicle's interprocess. Navigation as the course's manager: its own ``node_status`` goes out as ``usv_nav``
+(satellite to topside, acoustic broadcast to the AUVs), and each AUV's ``auv_nav`` is forwarded topside.
 """
 
 from __future__ import annotations
