@@ -82,6 +82,16 @@ def test_course_plugin_posts_contacts_and_commands(plugin_stack):
     mail_until(watcher, got, lambda: any("X=-123.4" in r for r in reports()), gateway, "second NODE_REPORT")
     assert reports() == ["NAME=USV,TYPE=USV,TIME=1700000062.5,X=-123.4,Y=-20.5,DEPTH=2,HDG=90,SPD=1.5"]
 
+    # A report pHelmIvP could not read (NaN heading) is refused with one line; the next one still goes through.
+    got.clear()
+    bad = nav(55.5, REFERENCE_S + 13.0)
+    bad.heading = float("nan")
+    client.publish(groups.usv_nav, bad)
+    client.publish(groups.usv_nav, nav(66.6, REFERENCE_S + 14.0))
+    mail_until(watcher, got, lambda: any("X=66.6" in r for r in reports()), gateway, "NODE_REPORT after a bad one")
+    assert [r for r in reports() if "X=55.5" in r] == []
+    assert "not posting NODE_REPORT" in gateway.stderr() and "Traceback" not in gateway.stderr()
+
     got.clear()
     client.publish(groups.auv_command, AUVCommand(time=REFERENCE_S, desired_state=AUVCommand.RECOVER))
     mail_until(watcher, got, lambda: any(m.key() == "AUV_DEPLOY_STATE" for m in got), gateway, "AUV_DEPLOY_STATE")
