@@ -1,4 +1,5 @@
-# Two commands: `make demo` runs the USV mission on embedded defaults; `make test` passes the tests.
+# Two commands: `make demo` runs the trail mission (topside, USV, 4 AUVs) on embedded defaults (`make demo
+# MISSION=usv`: the USV mission alone); `make test` passes the tests.
 # Each creates its own virtual environment in .venv on first use.
 PYTHON ?= python3
 VENV := .venv
@@ -14,8 +15,11 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e '.[test,demo]'
 	touch $@
 
+MISSION ?= trail
+
 demo: $(VENV)/.installed
-	$(BIN)/python -m launch.usv.demo $(DEMO_ARGS)
+	@case "$(MISSION)" in trail|usv) ;; *) echo "MISSION must be trail or usv, not '$(MISSION)'" >&2; exit 2;; esac
+	$(BIN)/python -m launch.$(MISSION).demo $(DEMO_ARGS)
 
 test: $(VENV)/.installed
 	$(BIN)/python -m pytest -q
@@ -29,6 +33,8 @@ protos: $(VENV)/.installed
 interfaces: $(VENV)/.installed
 	$(BIN)/goby-interfaces generate --all
 	$(BIN)/goby-interfaces visualize docs/interfaces/usv_deployment.yml --outdir docs/interfaces --no-disconnected --format svg
+	$(BIN)/python -m launch.trail.deployment 4
+	$(BIN)/goby-interfaces visualize docs/interfaces/trail_deployment.yml --outdir docs/interfaces --no-disconnected --format svg
 
 lint: $(VENV)/.installed
 	$(BIN)/ruff check .
