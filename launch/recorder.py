@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from collections import Counter
 from typing import Any
 
 from frontseat import groups as frontseat_groups
@@ -57,18 +58,21 @@ class MoosRecorder:
     queues mail, as the pymoos contract wants.
     """
 
-    def __init__(self, record: MissionRecord, clock: SimClock, moos_port: int, name: str = "uUsvDemoRecorder"):
+    def __init__(self, record: MissionRecord, clock: SimClock, moos_port: int, name: str = "uUsvDemoRecorder",
+                 variables: tuple[str, ...] | None = None):
         self.record = record
+        self.variables = variables if variables is not None else (*NAV_VARS, *EVENT_VARS)
         self.clock = clock
         self.moos_port = moos_port
         self.name = name
         self.comms = comms(clock=MoosClock(clock.warp))
         self.comms.set_on_connect_callback(self._on_connect)
         self.mail_count = 0
+        self.counts: Counter[str] = Counter()  # messages per variable (the fleet benchmark's NAV rate)
         self._last: dict[str, str] = {}
 
     def _on_connect(self) -> bool:
-        for var in (*NAV_VARS, *EVENT_VARS):
+        for var in self.variables:
             self.comms.register(var, 0)
         return True
 
@@ -84,6 +88,7 @@ class MoosRecorder:
         now = self.clock.now()
         for msg in messages:
             name = msg.key()
+            self.counts[name] += 1
             if name in NAV_VARS and msg.is_double():
                 self.record.add_nav(now, name, msg.double())
             elif name in EVENT_VARS:

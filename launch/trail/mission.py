@@ -97,6 +97,7 @@ class TrailMission:
         launch_delay_s: float = 1.0,
         platform: str = "trail",
         keep_going: bool = False,
+        moos_variables: tuple[str, ...] | None = None,
     ) -> None:
         self.settings = settings
         self.n_auvs = n_auvs
@@ -108,6 +109,7 @@ class TrailMission:
         # keep_going: a platform whose launcher dies (it stops its own processes first) is noted in ``deaths`` and
         # the other platforms run on; otherwise the first death ends the run.
         self.keep_going = keep_going
+        self.moos_variables = moos_variables  # what the MOOS recorders register for (None: track, helm, commands)
         self.deaths: list[tuple[float, str, str]] = []  # (sim time, launcher, last lines of its log)
         self.clock = SimClock(settings.warp)
         self.runs = {v.name: VehicleRun(v) for v in (vehicles if vehicles is not None else fleet(n_auvs))}
@@ -147,7 +149,7 @@ class TrailMission:
         for run in self.runs.values():
             if run.vehicle.kind != "topside":
                 run.moos = MoosRecorder(run.record, self.clock, run.vehicle.moos_port(self.settings),
-                                        name=f"uTrailRecorder_{run.vehicle.name}")
+                                        name=f"uTrailRecorder_{run.vehicle.name}", variables=self.moos_variables)
                 run.moos.start()
         self.group.on_wait = self.poll_moos
         self.group.start()
