@@ -20,9 +20,6 @@ MESSAGES: dict[str, dict] = FIELD_SET["messages"]
 ENUMS: dict[str, dict[str, int]] = FIELD_SET["enums"]
 EXTENSIONS = {(e["extendee"], e["number"]): e for e in FIELD_SET["extensions"]}
 _TYPE = {v: k[len("TYPE_"):].lower() for k, v in descriptor_pb2.FieldDescriptorProto.Type.items()}
-# Known and documented: the USV mission's goby-liaison config carries our web page's settings (map, command acks)
-# as a project extension of LiaisonConfig (docs/liaison.md), which the real goby_liaison refuses.
-KNOWN_PROJECT_EXTENSIONS = {"goby_moos_py.liaison.protobuf.web"}
 
 
 def _claims_goby(package: str) -> bool:
@@ -128,8 +125,6 @@ def goby_field_problems(msg: pb_message.Message, where: str) -> list[str]:
     by_number = {f["number"]: f for f in goby["fields"]}
     for field, value in msg.ListFields():
         path = f"{where}.{field.full_name if field.is_extension else field.name}"
-        if field.is_extension and field.full_name in KNOWN_PROJECT_EXTENSIONS:
-            continue
         known = EXTENSIONS.get((name, field.number)) if field.is_extension else by_number.get(field.number)
         if known is None:
             problems.append(f"{path} (= {field.number}) is not in Goby3's {name}")

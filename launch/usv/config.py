@@ -85,14 +85,19 @@ def _vehicle_interprocess(settings: UsvSettings) -> str:
 
 
 def _liaison(settings: UsvSettings) -> str:
-    """goby-liaison's config: the course's liaison.pb.cfg.in, our commander target and the map of usv.bhv."""
+    """goby-liaison's config: the course's liaison.pb.cfg.in with our commander target (Goby3's fields only)."""
+    return render(TEMPLATES / "liaison.pb.cfg.in", _values(settings, "goby-liaison"))
+
+
+def _liaison_web(settings: UsvSettings) -> str:
+    """goby-liaison's own settings (``--web``): the map of usv.bhv and the command acknowledgements."""
     values = _values(settings, "goby-liaison")
     points = "\n    ".join(f"waypoint {{ x: {x:g} y: {y:g} }}" for x, y in bhv_waypoints(settings.bhv_file))
     polygon = bhv_loiter_polygon(settings.bhv_file)
     if polygon is not None:
         points += "\n    " + "\n    ".join(f"loiter_polygon {{ x: {x:.1f} y: {y:.1f} }}" for x, y in polygon.vertices)
     values["map_points"] = points
-    return render(TEMPLATES / "liaison.pb.cfg.in", values)
+    return render(TEMPLATES / "liaison_web.pb.cfg.in", values)
 
 
 def moos_file_text(settings: UsvSettings) -> str:
@@ -131,6 +136,7 @@ GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
     "usv_command": _topside("shore.pb.cfg.in", "usv-command"),  # for sending commands by hand
     "vehicle_interprocess": _vehicle_interprocess,
     "liaison": _liaison,
+    "liaison_web": _liaison_web,  # given on goby-liaison's command line (--web), like frontseat_tuning
     "moos": _moos,
 }
 

@@ -186,3 +186,22 @@ def test_the_printed_command_environment_reproduces_the_runs_usv_command_config(
     assert export.startswith("export USV_RUN_DIR=") and "USV_WARP=37" in export
     assert waypoints.split()[1:] == ["waypoints", "<(" + sys.executable, "-m", "launch.usv.config", "usv_command)"]
     assert "polygon --sides 8 --radius 400 <(" in polygon
+
+
+def test_liaison_web_settings_travel_on_the_command_line(settings, tmp_path):
+    # the file keeps Goby3's LiaisonConfig fields (the real goby_liaison accepts it); --web carries our extension
+    from gateway.goby.portal.config import load_config
+    from gateway.goby.portal.errors import AppConfigError
+    from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
+    from launch.liaison.protobuf.liaison_web_pb2 import web
+
+    path = tmp_path / "liaison.pb.cfg"
+    path.write_text(generate("liaison", settings))
+    assert not text_format.Parse(path.read_text(), LiaisonConfig()).HasExtension(web)
+    cfg = load_config(LiaisonConfig, [str(path), "--web", generate("liaison_web", settings)], environ={}).cfg
+    extra = cfg.Extensions[web]
+    assert extra.map.center_activate and len(extra.map.waypoint) >= 1
+    assert extra.interprocess_ack[0].command_type == "goby3_course.dccl.USVCommand"
+    assert cfg.http_port == settings.liaison_port
+    with pytest.raises(AppConfigError, match="--web"):
+        load_config(LiaisonConfig, [str(path), "--web", "map { no_such_field: 1 }"], environ={})

@@ -82,6 +82,17 @@ def _scalar_override(field: pb_descriptor.FieldDescriptor, value: str) -> str:
     return f"{field.name}: {value}"
 
 
+def project_extensions(config_type: type[pb_message.Message]) -> list[pb_descriptor.FieldDescriptor]:
+    """Extensions of the config message declared outside Goby's packages: this project's own settings.
+
+    A config file with them is refused by the real Goby app, so launchers give them on the command line instead,
+    ``--<extension name> TEXT`` (as ``--<field>`` for Goby's fields), and the file keeps Goby's fields only.
+    """
+    pool = config_type.DESCRIPTOR.file.pool
+    found = pool.FindAllExtensions(config_type.DESCRIPTOR)
+    return sorted((e for e in found if not e.full_name.startswith("goby.")), key=lambda e: e.number)
+
+
 def build_parser(config_type: type[pb_message.Message], prog: str | None = None) -> argparse.ArgumentParser:
     """Goby-style command line: a config file, ``--<top-level field> VALUE`` overrides, ``-e``, ``-v``."""
     parser = argparse.ArgumentParser(
@@ -104,6 +115,12 @@ def build_parser(config_type: type[pb_message.Message], prog: str | None = None)
                                 help=f"override {field.name}: {kind}")
         except argparse.ArgumentError:
             pass  # a field named like a common option (e.g. "verbose"): set it in the file or a message block
+    for ext in project_extensions(config_type):
+        try:
+            parser.add_argument(f"--{ext.name}", action="append", metavar="TEXT", dest=f"ext_{ext.full_name}",
+                                help=f"set the project extension [{ext.full_name}] (text format)")
+        except argparse.ArgumentError:
+            pass  # named like a field or option: give it in the config file as [{full_name}] { ... }
     return parser
 
 
@@ -134,6 +151,13 @@ def load_config(
                     getattr(cfg, field.name).SetInParent()
             else:
                 _merge_text(cfg, _scalar_override(field, value), f"--{field.name}")
+    for ext in project_extensions(config_type):
+        for value in getattr(args, f"ext_{ext.full_name}", None) or ():
+            if ext.type == _FD.TYPE_MESSAGE and not _is_repeated(ext):
+                _merge_text(cfg.Extensions[ext], value, f"--{ext.name}")
+                cfg.Extensions[ext].SetInParent()
+            else:
+                _merge_text(cfg, f"[{ext.full_name}]: {value}", f"--{ext.name}")
     fields = config_type.DESCRIPTOR.fields_by_name
     if "interprocess" in fields and not cfg.HasField("interprocess") and environ.get(INTERPROCESS_ENV):
         _merge_text(cfg.interprocess, environ[INTERPROCESS_ENV], f"${INTERPROCESS_ENV}")
