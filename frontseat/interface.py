@@ -216,6 +216,11 @@ def example_config(driver_module: object | None = None) -> str:
     if extension is not None:
         driver_body = message_example(extension.message_type, 2)
         frontseat_body += f"\n  [{extension.full_name}] {{  # the driver's settings\n{driver_body}\n  }}"
+    tuning = getattr(driver_module, "TUNING_EXTENSION", None)
+    if tuning is not None:  # a project extension: commented out, so the example stays a Goby3 config
+        tuning_body = "\n".join("  #" + line[1:] for line in message_example(tuning.message_type, 2).splitlines())
+        frontseat_body += (f"\n  # [{tuning.full_name}] {{  # our driver's own settings (not in Goby3)\n"
+                           f"{tuning_body}\n  # }}")
     helm_body = message_example(gateway_pb.GobyMOOSGatewayConfig.MOOSConfig.DESCRIPTOR, 1)
     helm_body = "\n".join(f"# {line}" for line in helm_body.splitlines())
     return (

@@ -3,7 +3,8 @@
 ``FRONTSEAT_DRIVER_LIBRARY`` names the driver: an entry point of group ``goby_frontseat.drivers``
 (``basic_simulator``), Goby's library file name for it (``libgoby_frontseat_basic_simulator.so.30``), a Python
 file, or a dotted module.  The module must define ``frontseat_driver_load(cfg) -> FrontSeatDriver`` and may define
-``CONFIG_EXTENSION`` (the driver's ``Config`` extension field, used for ``--example_config``). Importing the
+``CONFIG_EXTENSION`` (the driver's ``Config`` extension field, used for ``--example_config``) and
+``TUNING_EXTENSION`` (a project extension with settings Goby's driver hard-codes, shown commented out). Importing the
 module registers its config extension, one driver per process, which keeps clashing extension numbers
 (1001: basic simulator and Waveglider) apart.
 

@@ -34,6 +34,7 @@ def test_help_needs_no_driver_and_loads_none(tmp_path: Path, flag: str) -> None:
 
 def test_example_config_without_a_driver_shows_the_basic_simulator_block(tmp_path: Path) -> None:
     from frontseat.protobuf import basic_simulator_config_pb2 as sim_pb
+    from frontseat.protobuf import basic_simulator_tuning_pb2 as tuning_pb
     from frontseat.protobuf import frontseat_interface_config_pb2 as app_pb
 
     for flag in ("--example_config", "-e"):
@@ -44,6 +45,9 @@ def test_example_config_without_a_driver_shows_the_basic_simulator_block(tmp_pat
         assert EXTENSION in done.stdout
         cfg = text_format.Parse(done.stdout, app_pb.FrontSeatInterfaceConfig())
         assert cfg.frontseat_cfg.HasExtension(sim_pb.basic_simulator_config)
+        # our driver's own settings are shown commented out: the example stays a config Goby3 accepts
+        assert "# [goby_moos_py.frontseat.protobuf.basic_simulator_tuning] {" in done.stdout
+        assert not cfg.frontseat_cfg.HasExtension(tuning_pb.basic_simulator_tuning)
 
 
 def test_example_config_with_a_driver_uses_that_driver(tmp_path: Path) -> None:
