@@ -27,7 +27,7 @@ WATCHED = ["NODE_REPORT", "DEPLOY_DEPTH_UPDATES", "AUV_DEPLOY_STATE", "DEPLOY_ST
 def gateway_config(interprocess_text: str, moos_port: int) -> str:
     return (f"app {{ simulation {{ time {{ use_sim_time: true warp_factor: {WARP} "
             f"reference_microtime: {REFERENCE_S * 1_000_000} }} }} }}\n"
-            f"interprocess {{ {interprocess_text} }}\n"
+            f"interprocess {{ {interprocess_text} manager_timeout_seconds: 60 }}\n"
             f'moos {{ server: "127.0.0.1" port: {moos_port} }}\n')
 
 

@@ -48,6 +48,11 @@ def app_block() -> str:
             f"simulation {{ time {{ use_sim_time: true warp_factor: {WARP} }} }} }}\n")
 
 
+def interprocess_block(broker: BrokerProcess) -> str:
+    # A loaded machine may take longer than Goby's default 5 s to answer a new client (ten processes start at once).
+    return f"interprocess {{ {broker.interprocess_text()} manager_timeout_seconds: 60 }}\n"
+
+
 @dataclass
 class Fleet:
     workdir: Path
@@ -65,7 +70,7 @@ class Fleet:
     def process(self, name: str, module: str, broker: str, config: str) -> contextlib.AbstractContextManager:
         """A Goby-style app on ``broker``'s interprocess with ``config`` (after the common ``app {}`` block)."""
         path = self.workdir / f"{name}.pb.cfg"
-        path.write_text(app_block() + config)
+        path.write_text(app_block() + interprocess_block(self.brokers[broker]) + config)
         return running(name, [sys.executable, "-m", module, str(path), "-v"], self.workdir, self.brokers[broker].env())
 
     def app(self, name: str, module: str, broker: str, config: str) -> None:
@@ -88,15 +93,15 @@ def fleet(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Fleet]:
             cfg = workdir / f"gobyd_{name}.pb.cfg"
             cfg.write_text(broker_config(links, warp=WARP))
             brokers[name] = exits.enter_context(BrokerProcess(workdir, platform=f"trail_{name}", extra_args=[str(cfg)],
-                                                              log_path=workdir / f"gobyd_{name}.log"))
+                                                              log_path=workdir / f"gobyd_{name}.log",
+                                                              startup_timeout=90.0))
         db = exits.enter_context(moosdb_process(workdir, community="AUV0", warp=WARP))
         built = Fleet(workdir, brokers, db.port, _exits=exits)
         built.app("topside_manager", "translators.apps.topside_manager", "topside",
                   f'usv_modem_id: {USV_SAT}\nvehicle_name_prefix: "trail_"\n')
         built.app("usv_manager", "translators.apps.usv_manager", "usv", f"vehicle_id: 1\nauv_modem_id: {AUV_ACOMMS}\n")
         built.app("auv_manager", "translators.apps.auv_manager", "auv0", f"usv_modem_id: {USV_ACOMMS}\nvehicle_id: 2\n")
-        gateway_cfg = (app_block() +
-                       f"interprocess {{ {brokers['auv0'].interprocess_text()} }}\n"
+        gateway_cfg = (app_block() + interprocess_block(brokers["auv0"]) +
                        f'moos {{ server: "127.0.0.1" port: {db.port} }}\n')
         built.children.append(exits.enter_context(
             GatewayProcess(workdir, ["libgoby3_course_moos_gateway_plugin.so"], gateway_cfg, extra_args=["-v"])))
