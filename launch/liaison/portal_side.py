@@ -14,10 +14,12 @@ from typing import Any
 from google.protobuf import text_format
 from google.protobuf.message import Message
 
+from gateway.goby.intervehicle import AckData, ExpireData, Publisher
 from gateway.goby.portal import SingleThreadApplication, StartError
 from gateway.goby.portal.errors import ClosedError
+from gateway.goby.portal.group import Group
 from gateway.goby.portal.marshalling import Scheme
-from gateway.goby.protobuf.layer_pb2 import LAYER_INTERTHREAD
+from gateway.goby.protobuf.layer_pb2 import LAYER_INTERTHREAD, LAYER_INTERVEHICLE
 from launch.liaison.commander_model import CommanderModel, CommandType, Target
 from launch.liaison.errors import LiaisonError
 from launch.liaison.map_model import NODE_STATUS_TYPE, USV_COMMAND_TYPE, MapModel
@@ -93,6 +95,8 @@ class LiaisonApp(SingleThreadApplication):
             group = target.group_for(msg)
             if target.layer == LAYER_INTERTHREAD:
                 self.interthread().publish(group, msg)
+            elif target.layer == LAYER_INTERVEHICLE:
+                self.intervehicle().publish(group, msg, publisher=self._intervehicle_publisher(target, entry_id))
             else:
                 self.interprocess().publish(group, msg)
         except Exception as exc:  # noqa: BLE001 - reported to the page that sent it
@@ -101,6 +105,25 @@ class LiaisonApp(SingleThreadApplication):
             return
         log.info("sent %s to %s: %s", kind.name, target.label, text_format.MessageToString(msg, as_one_line=True))
         self.web.call(self.web.command_published, entry_id, None)
+
+    def _intervehicle_publisher(self, target: Target, entry_id: int) -> Publisher:
+        """Goby's commander publisher: ``set_group`` writes the numeric group into ``group_numeric_field_name``
+        (if configured), and the ack/expire callbacks (which make the link require an ack) report to the page's
+        history as ``Ack: ...`` / ``Expire: ...``. The callbacks run on the portal thread."""
+
+        def set_group(msg: Message, group: Group) -> None:
+            if target.numeric_field:
+                setattr(msg, target.numeric_field, group.numeric)
+
+        def on_ack(_msg: Message, ack: AckData) -> None:
+            text = f"Ack: {text_format.MessageToString(ack, as_one_line=True)}"
+            self.web.call(self.web.command_acknowledged, entry_id, text)
+
+        def on_expire(_msg: Message, expire: ExpireData) -> None:
+            text = f"Expire: {text_format.MessageToString(expire, as_one_line=True)}"
+            self.web.call(self.web.command_expired, entry_id, text)
+
+        return Publisher(set_group=set_group, on_ack=on_ack, on_expire=on_expire)
 
     # ---------------------------------------------------------------------------------- web thread
     def _hand_over(self, kind: CommandType, target: Target, msg: Message, entry_id: int) -> None:

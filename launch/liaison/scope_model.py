@@ -15,6 +15,7 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
+from gateway.goby.dccl import Codec as DcclCodec
 from gateway.goby.portal.marshalling import scheme_to_string
 from launch.liaison.decode import decode_payload
 
@@ -56,6 +57,7 @@ class ScopeModel:
         self._last_tick: float | None = None
         self.refused_rows = 0  # publications on a new (group, type, scheme) beyond max_rows
         self.received = 0
+        self._dccl = DcclCodec()  # web thread: decodes DCCL-scheme rows (the intervehicle layer's echoes)
 
     # ---------------------------------------------------------------------------------- portal thread
     def ingest(self, group: str, scheme: int, type_name: str, payload: bytes, when: float) -> None:
@@ -103,7 +105,7 @@ class ScopeModel:
             if version == row.sent_version and not rate_moved:
                 continue
             if version != row.sent_version:
-                decoded = decode_payload(latest, row.scheme, row.type_name, self.max_message_size)
+                decoded = decode_payload(latest, row.scheme, row.type_name, self.max_message_size, self._dccl)
                 row.view = {
                     "id": row.id, "group": row.group, "type": row.type_name, "scheme": scheme_to_string(row.scheme),
                     "value": decoded.short, "ok": decoded.ok, "time": when,
@@ -132,7 +134,7 @@ class ScopeModel:
         if limit is not None:
             items = items[:limit]
         return [{"time": when, "value": decode_payload(payload, row.scheme, row.type_name,
-                                                         self.max_message_size).full}
+                                                         self.max_message_size, self._dccl).full}
                 for when, payload in items]
 
     def row_count(self) -> int:

@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 
 from google.protobuf.message import Message
 
-from gateway.goby.protobuf.layer_pb2 import LAYER_INTERVEHICLE, Layer
+from gateway.goby.portal.marshalling import is_dccl
+from gateway.goby.protobuf.layer_pb2 import LAYER_INTERVEHICLE
 from launch.liaison.commander_model import CommandType, Target
 from launch.liaison.errors import LiaisonConfigError
 from launch.liaison.fanout import compile_filter
@@ -21,8 +22,6 @@ from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
 from launch.liaison.protobuf.liaison_web_pb2 import InterProcessAck, WebConfig, web
 
 Point = tuple[float, float]
-#: The layers a command can be published on in this build (intervehicle comes with the intervehicle layer).
-SUPPORTED_LAYERS = frozenset(v.number for v in Layer.DESCRIPTOR.values) - {LAYER_INTERVEHICLE}
 
 
 @dataclass
@@ -59,14 +58,13 @@ def web_config(cfg: LiaisonConfig) -> WebConfig:
 def _targets(load: LiaisonConfig, cls: type[Message], where: str) -> tuple[Target, ...]:
     targets = []
     for index, entry in enumerate(load.publish_to):
-        if entry.layer not in SUPPORTED_LAYERS:
-            raise LiaisonConfigError(
-                f"{where}.publish_to[{index}]: layer {Layer.Name(entry.layer)} is not available in this build "
-                "(use LAYER_INTERPROCESS)")
         numeric_field = entry.group_numeric_field_name if entry.HasField("group_numeric_field_name") else ""
         if numeric_field and numeric_field not in cls.DESCRIPTOR.fields_by_name:
             raise LiaisonConfigError(f"{where}.publish_to[{index}]: {cls.DESCRIPTOR.full_name} has no field "
                                      f"{numeric_field!r} (group_numeric_field_name)")
+        if entry.layer == LAYER_INTERVEHICLE and not is_dccl(cls):
+            raise LiaisonConfigError(f"{where}.publish_to[{index}]: {cls.DESCRIPTOR.full_name} is not a DCCL message "
+                                     "(LAYER_INTERVEHICLE sends DCCL only)")
         if not entry.group.strip():
             raise LiaisonConfigError(f"{where}.publish_to[{index}]: empty group")
         targets.append(Target(index, entry.group, entry.group_numeric, numeric_field, entry.layer))

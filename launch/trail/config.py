@@ -162,13 +162,6 @@ def _manager(app: str, kind: str) -> Callable[[TrailSettings, Vehicle], str]:
     return generate
 
 
-def liaison_supports_intervehicle() -> bool:
-    from gateway.goby.protobuf.layer_pb2 import LAYER_INTERVEHICLE
-    from launch.liaison.settings import SUPPORTED_LAYERS
-
-    return LAYER_INTERVEHICLE in SUPPORTED_LAYERS
-
-
 def _liaison(settings: TrailSettings, vehicle: Vehicle) -> str:
     """goby-liaison: the topside's Commander sends USVCommand on intervehicle usv_command/0, as the course's."""
     values = _values(settings, vehicle, "goby-liaison")
@@ -180,10 +173,6 @@ def _liaison(settings: TrailSettings, vehicle: Vehicle) -> str:
     publish_to { group: "goby3_course::usv_command" group_numeric: 0 layer: LAYER_INTERVEHICLE }
   }
 }"""
-        if not liaison_supports_intervehicle():
-            commander = "# goby-liaison cannot publish on intervehicle yet; the course's Commander entry:\n" + "\n".join(
-                f"# {line}" for line in commander.splitlines()
-            )
     values["commander_block"] = commander
     return render(TEMPLATES / "liaison.pb.cfg.in", values)
 

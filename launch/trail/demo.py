@@ -156,6 +156,16 @@ def report(result: TrailResult, operator: MissionRecord, n_auvs: int, links: Lin
                         None if links is None else links.error, dict(view))
 
 
+def liaison_urls_line(settings: TrailSettings, n_auvs: int) -> str:
+    """Where the platforms' goby-liaison pages are: the topside's commander (USVCommand over the satellite link)
+    and every vehicle's scope, at port 50000 + platform id as in the course."""
+    host = "127.0.0.1" if settings.liaison_address in ("", "0.0.0.0", "::") else settings.liaison_address
+    vehicles = [Vehicle("topside", n_auvs), Vehicle("usv", n_auvs), *(Vehicle("auv", n_auvs, i) for i in range(n_auvs))]
+    pages = [f"{v.name} http://{host}:{v.liaison_port(settings)}/" for v in vehicles]
+    return (f"web pages (goby-liaison): {', '.join(pages)}; command the USV from "
+            f"http://{host}:{vehicles[0].liaison_port(settings)}/?_=/commander")
+
+
 def _report(line: str) -> None:
     """The launcher's lines: deaths always, the rest with -v."""
     if "died" in line:
@@ -190,6 +200,7 @@ def run_demo(args: argparse.Namespace) -> int:
     try:
         print(f"starting {len(mission.entries)} platforms ...", flush=True)
         mission.start()
+        print(liaison_urls_line(settings, n), flush=True)
         topside = PortalWorker("topside", Vehicle("topside", n).ipc_base(settings), settings.warp)
         usv = PortalWorker("usv", Vehicle("usv", n).ipc_base(settings), settings.warp) if args.usv_helm == "ivp" else None
         workers = [w for w in (topside, usv) if w is not None]

@@ -89,6 +89,14 @@ def _liaison(settings: UsvSettings) -> str:
     return render(TEMPLATES / "liaison.pb.cfg.in", _values(settings, "goby-liaison"))
 
 
+def _topside_liaison(settings: UsvSettings) -> str:
+    """The topside's goby-liaison (the course's topside page): its Commander sends USVCommand on intervehicle
+    ``goby3_course::usv_command`` group 0 over the satellite link, acked by the USV's modem."""
+    values = _topside_values(settings, "goby-liaison")
+    values["liaison_port"] = settings.topside_liaison_port
+    return render(TEMPLATES / "topside_liaison.pb.cfg.in", values)
+
+
 def _liaison_web(settings: UsvSettings) -> str:
     """goby-liaison's own settings (``--web``): the map of usv.bhv and the command acknowledgements."""
     values = _values(settings, "goby-liaison")
@@ -136,6 +144,7 @@ GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
     "usv_command": _topside("shore.pb.cfg.in", "usv-command"),  # for sending commands by hand
     "vehicle_interprocess": _vehicle_interprocess,
     "liaison": _liaison,
+    "topside_liaison": _topside_liaison,
     "liaison_web": _liaison_web,  # given on goby-liaison's command line (--web), like frontseat_tuning
     "moos": _moos,
 }

@@ -91,6 +91,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--sim-port", type=int, default=0, help="frontseat simulator port (default 55001 if free)")
     parser.add_argument("--liaison-port", type=int, default=0,
                         help="goby-liaison's web page port (default 50001, the course's, if free)")
+    parser.add_argument("--topside-liaison-port", type=int, default=0,
+                        help="the topside's goby-liaison (Commander over the satellite link) port "
+                        "(default 50000, the course's, if free)")
     parser.add_argument("--listen", default="127.0.0.1", metavar="ADDRESS",
                         help="address goby-liaison's page listens on (default 127.0.0.1, this machine only). "
                         "RISK: another address (0.0.0.0 = every interface) lets anyone who can reach it watch "
@@ -121,6 +124,7 @@ def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> 
         sim_port=_port(args.sim_port, 55001),
         liaison_address=args.listen,
         liaison_port=_port(args.liaison_port, 50001),
+        topside_liaison_port=_port(args.topside_liaison_port, 50000),
         moosdb=choose_program(args.moosdb, "MOOSDB", "moos-db"),
         helm=choose_program(args.helm, "pHelmIvP", "ivp-helm"),
         schedule=args.schedule,
@@ -202,8 +206,12 @@ def run_demo(args: argparse.Namespace) -> int:
         urls = mission.liaison_urls()
         print("web pages of this run (goby-liaison): " + ", ".join(f"{view} {url}" for view, url in urls.items()),
               flush=True)
+        topside = mission.liaison_urls(process_name="topside.liaison")
+        print("topside page (goby-liaison, commands over the satellite link): "
+              + ", ".join(f"{view} {url}" for view, url in topside.items()), flush=True)
         if mission.wait_for_command() is not None:
-            print(f"the vehicle is under helm command. Command it from the browser: {urls['commander']}\n"
+            print(f"the vehicle is under helm command. Command it from the browser: {topside['commander']} "
+                  f"(over the satellite link) or {urls['commander']} (the shore's interprocess leg)\n"
                   "or, in another terminal (bash):\n"
                   + "\n".join(f"  {line}" for line in command_lines(settings)), flush=True)
         mission.run(duration, lambda t: print(progress_line(mission.record, t, duration), flush=True))

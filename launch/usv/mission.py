@@ -108,12 +108,13 @@ class UsvMission:
                                   f"(logs in {self.settings.log_dir})")
             time.sleep(0.1)
 
-    def liaison_urls(self, timeout_s: float = 30.0) -> dict[str, str]:
-        """The URLs goby-liaison serves (home, scope, commander, map), read from its ready line in its log."""
+    def liaison_urls(self, timeout_s: float = 30.0, process_name: str = "goby-liaison") -> dict[str, str]:
+        """The URLs a goby-liaison serves (home, scope, commander, map), read from its ready line in its log:
+        the USV's (``goby-liaison``) or the topside's (``process_name="topside.liaison"``)."""
         assert self.group is not None
-        process = next((p for p in self.group.processes if p.name.endswith("goby-liaison")), None)
+        process = next((p for p in self.group.processes if p.name.endswith(process_name)), None)
         if process is None:
-            raise LaunchError("the launch file starts no goby-liaison")
+            raise LaunchError(f"the launch file starts no {process_name}")
         deadline = time.monotonic() + timeout_s
         while True:
             self._check()

@@ -41,6 +41,7 @@ _ENV = {
     "socket_name": "USV_SOCKET_NAME",
     "liaison_address": "USV_LIAISON_ADDRESS",
     "liaison_port": "USV_LIAISON_PORT",
+    "topside_liaison_port": "USV_TOPSIDE_LIAISON_PORT",
     "sat_port": "USV_SAT_PORT",
 }
 
@@ -65,15 +66,16 @@ class UsvSettings:
     socket_name: str = ""
     liaison_address: str = "127.0.0.1"  # goby-liaison's http_address: loopback unless asked (it has no login)
     liaison_port: int = 50001  # the course's liaison port: 50000 + vehicle id
+    topside_liaison_port: int = 0  # the topside's page (Commander); the demo asks for the course's 50000; 0: any free
     sat_port: int = 54500  # the satellite link's UDP multicast port (the course's; 239.142.0.2)
     topside_platform: str = "topside"  # the shore's own broker (satellite modem 1)
 
     def __post_init__(self) -> None:
         if self.warp < 1:
             raise MissionConfigError(f"warp must be a whole number >= 1, not {self.warp}")
-        for port_name in ("moos_port", "sim_port", "liaison_port", "sat_port"):
+        for port_name in ("moos_port", "sim_port", "liaison_port", "sat_port", "topside_liaison_port"):
             port = getattr(self, port_name)
-            if not 0 < port < 65536:
+            if not 0 < port < 65536 and not (port == 0 and port_name == "topside_liaison_port"):
                 raise MissionConfigError(f"{port_name} {port} is not a TCP port")
         if not -90 <= self.lat_origin <= 90 or not -180 <= self.lon_origin <= 180:
             raise MissionConfigError(f"origin {self.lat_origin},{self.lon_origin} is not a latitude,longitude")

@@ -146,6 +146,45 @@ def test_commander_refuses_out_of_range_then_sends_the_octagon(mission, browser)
     screenshot(browser, "commander")
 
 
+def send_octagon(browser) -> None:
+    """Fill the commander's form with POLYGON, 8 sides, radius 400, and Send."""
+    from selenium.webdriver.support.ui import Select
+
+    wait_until(lambda: browser.find_elements("css selector", '[data-path="desired_state"]'), what="the form")
+    Select(browser.find_element("css selector", '[data-path="desired_state"]')).select_by_value("POLYGON")
+    browser.find_element("css selector", '[data-path="polygon_sides"]').send_keys("8")
+    browser.find_element("css selector", '[data-path="polygon_radius"]').send_keys("400")
+    browser.find_element("id", "send").click()
+
+
+def test_topside_commander_sends_the_octagon_over_the_satellite_link(mission, browser):
+    """The course's way: the topside's page (its own broker) sends on intervehicle; the USV's modem acks."""
+    from selenium.webdriver.support.ui import Select
+
+    browser.get(mission.liaison_urls(process_name="topside.liaison")["commander"])
+    wait_until(lambda: browser.find_elements("css selector", "#command-target option"), what="the targets")
+    target = Select(browser.find_element("id", "command-target")).first_selected_option.text
+    assert target == "goby3_course::usv_command/0 [intervehicle]"
+    before = len(command_effects(mission.record))
+    send_octagon(browser)
+    state = wait_until(lambda: (cell := browser.find_elements("css selector", "#sent-table tbody tr td.state"))
+                       and cell[0].text not in ("sending", "sent") and cell[0], timeout=60, what="the link's ack")
+    acks = state.find_element("xpath", "following-sibling::td").text
+    assert state.text == "acknowledged", acks
+    assert acks.startswith("Ack: ") and "src: 2" in acks  # the USV's satellite modem
+
+    def new_effect():
+        mission.poll()
+        effects = command_effects(mission.record)
+        return effects[before:] if len(effects) > before else None
+
+    (effect,) = wait_until(new_effect, what="the command's postings on the USV's MOOSDB")
+    assert [p.name for p in effect.posts] == ["POLYGON_UPDATES", "DEPLOY_STATE"]
+    assert effect.posts[0].value == "polygon=radial::x=0,y=0,radius=400,pts=8"
+    assert effect.posts[1].value == "POLYGON"
+    screenshot(browser, "topside_commander")
+
+
 def test_map_draws_the_vehicle_its_trail_and_the_overlays(mission, browser):
     browser.get(mission.urls["map"])
     icon = wait_until(lambda: browser.find_elements("css selector", "#map-vehicles path.vehicle"), what="a vehicle")

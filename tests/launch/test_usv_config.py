@@ -205,3 +205,21 @@ def test_liaison_web_settings_travel_on_the_command_line(settings, tmp_path):
     assert cfg.http_port == settings.liaison_port
     with pytest.raises(AppConfigError, match="--web"):
         load_config(LiaisonConfig, [str(path), "--web", "map { no_such_field: 1 }"], environ={})
+
+
+def test_the_topside_liaison_commands_over_the_satellite_link(settings):
+    """The course's topside page: on the topside's broker, USVCommand on intervehicle group 0 (checked by
+    goby-liaison's own settings loader, as at start)."""
+    from gateway.goby.protobuf.layer_pb2 import LAYER_INTERVEHICLE
+    from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
+    from launch.liaison.settings import load_settings
+
+    cfg = text_format.Parse(generate("topside_liaison", settings.replace(topside_liaison_port=50000)),
+                            LiaisonConfig())
+    assert cfg.interprocess.platform == "topside" and cfg.interprocess.socket_name == settings.topside_ipc_base
+    assert cfg.http_port == 50000
+    (kind,) = load_settings(cfg).command_types
+    assert kind.name == "goby3_course.dccl.USVCommand"
+    assert [(t.layer, t.label) for t in kind.targets] == [
+        (LAYER_INTERVEHICLE, "goby3_course::usv_command/0 [intervehicle]")]
+    assert "topside_liaison" in " ".join(e.command for e in parse_file(LAUNCH_FILE).entries)

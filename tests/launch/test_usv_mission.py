@@ -135,7 +135,7 @@ def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm, monkeypatch):
     assert octagon.mean_distance < 15.0, report
 
     # Every process stopped cleanly and no log holds an unexpected error.
-    assert len(result.outcomes) == 10, report
+    assert len(result.outcomes) == 11, report
     assert all(o.clean for o in result.outcomes), report
     assert result.log_errors == [], report
 

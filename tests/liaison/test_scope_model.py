@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
+from gateway.goby.dccl import Codec
 from gateway.goby.portal.marshalling import Scheme
 from launch.liaison.decode import decode_payload
 from launch.liaison.scope_model import ScopeModel
+from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 
 NODE = NodeStatus.DESCRIPTOR.full_name
 
@@ -49,10 +51,30 @@ def test_one_row_per_group_type_and_scheme():
     scope.ingest("g", Scheme.PROTOBUF, NODE, node(1), 0)
     scope.ingest("g", Scheme.DCCL, NODE, b"\x01\x02", 0)
     scope.ingest("g", Scheme.CSTR, "CSTR", b"hello\0", 0)
+    scope.ingest("g", Scheme.JSON, "j", b"{}", 0)
     rows = {(r["scheme"], r["value"]) for r in scope.tick(0)}
     assert ("CSTR", "hello") in rows
-    assert ("DCCL", "2 bytes: 01 02 (no decoder for this scheme)") in rows
-    assert len(rows) == 3
+    assert ("DCCL", f"2 bytes: 01 02 (does not parse as {NODE}: {NODE} has no DCCL options)") in rows
+    assert ("JSON", "2 bytes: 7b 7d (no decoder for this scheme)") in rows
+    assert len(rows) == 4
+
+
+def test_dccl_payloads_of_a_loaded_type_are_decoded_with_the_dccl_codec():
+    """The intervehicle layer's echoes on interprocess (scheme DCCL) show as text, as the PROTOBUF ones do."""
+    command = USVCommand(time=1700000000.5, desired_state=USVCommand.POLYGON, polygon_sides=8, polygon_radius=400)
+    codec = Codec()
+    codec.load(USVCommand)
+    data = codec.encode(command)
+    assert len(data) == 5  # the course's 5-byte command, not protobuf bytes
+    scope = ScopeModel()
+    scope.ingest("goby3_course::usv_command;0", Scheme.DCCL, "goby3_course.dccl.USVCommand", data, 0)
+    (row,) = scope.tick(0)
+    assert row["ok"] and row["scheme"] == "DCCL"
+    assert "desired_state: POLYGON" in row["value"] and "polygon_sides: 8 polygon_radius: 400" in row["value"]
+    truncated = decode_payload(data[:3], Scheme.DCCL, "goby3_course.dccl.USVCommand", dccl=Codec())
+    assert not truncated.ok and truncated.short.startswith("3 bytes: ") and "does not parse" in truncated.short
+    assert decode_payload(data, Scheme.DCCL, "goby3_course.dccl.USVCommand").short.endswith(
+        "(no decoder for this scheme)")  # no codec given
 
 
 def test_rows_are_bounded():

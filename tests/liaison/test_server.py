@@ -233,9 +233,9 @@ def test_too_many_pages_and_a_taken_port_are_refused(liaison, tmp_path):
         ('load_shared_library: "libnothing.so"', "Failed to open protobuf message library: libnothing.so"),
         ('load_proto_file: "x.proto"', "load_proto_file is not supported here"),
         ('pb_scope_config { group_regex_filter_expression: "[" }', "group filter '[' is not a valid"),
-        ('pb_commander_config { load_protobuf { name: "goby3_course.dccl.USVCommand" publish_to { group: "g" '
-         'layer: LAYER_INTERVEHICLE } } } load_shared_library: "libgoby3_course_messages.so"',
-         "layer LAYER_INTERVEHICLE is not available"),
+        ('pb_commander_config { load_protobuf { name: "goby_moos_py.usv.protobuf.USVCommandAck" publish_to { '
+         'group: "g" layer: LAYER_INTERVEHICLE } } } load_shared_library: "libgoby3_course_messages.so"',
+         "USVCommandAck is not a DCCL message (LAYER_INTERVEHICLE sends DCCL only)"),
     ],
 )
 def test_bad_configs_are_refused_naming_the_field(extra, words):
