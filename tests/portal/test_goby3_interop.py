@@ -1,11 +1,14 @@
 """Interoperability with the real Goby3 3.1 interprocess layer: our portal clients through a real ``gobyd``, and
-the real ``goby zeromq publish``/``subscribe`` tools (src/apps/zeromq/zeromq_tool/zeromq_tool.cpp) on our
-goby-broker. Skipped with the reason unless the binaries are on PATH inside a private network namespace
+the real ``goby zeromq publish``/``subscribe`` tools (src/apps/zeromq/zeromq_tool/zeromq_tool.cpp) with our client,
+both ways, on our goby-broker and on a real gobyd. Skipped with the reason unless the binaries are on PATH inside a private network namespace
 (tests/goby3_real.py)."""
 
 from __future__ import annotations
 
+import contextlib
 import shutil
+from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
@@ -28,10 +31,9 @@ def _ping_until_received(sender: PortalClient, receiver: PortalClient, group: st
     return receiver.poll_until(arrived, 20)
 
 
-def test_our_clients_talk_both_ways_through_a_real_gobyd(tmp_path) -> None:
-    reason = real_goby_skip_reason("gobyd")
-    if reason:
-        pytest.skip(reason)
+@contextlib.contextmanager
+def _real_gobyd(tmp_path: Path) -> Iterator[InterProcessPortalConfig]:
+    """A real gobyd on an IPC socket (``gobyd CFG``, CFG an ``interprocess { }`` block); yields the portal config."""
     ipc_dir = short_ipc_dir()
     ipc = InterProcessPortalConfig(platform="interop", transport=InterProcessPortalConfig.IPC,
                                    socket_name=str(ipc_dir / "goby_interop"))
@@ -39,28 +41,45 @@ def test_our_clients_talk_both_ways_through_a_real_gobyd(tmp_path) -> None:
     cfg.write_text(f"interprocess {{ {interprocess_text(ipc)} }}\n")
     gobyd = AppProcess(["gobyd", str(cfg)], log_path=tmp_path / "gobyd.log")
     try:
-        with PortalClient(ipc, "ours_a") as a, PortalClient(ipc, "ours_b") as b:
-            at_b = b.collect("interop::a_to_b", Sample)
-            at_a = a.collect("interop::b_to_a", Sample)
-            assert a.wait_subscribed() and b.wait_subscribed()  # the manager handshake with gobyd worked
-            assert _ping_until_received(a, b, "interop::a_to_b", at_b, 7), (tmp_path / "gobyd.log").read_text()
-            assert _ping_until_received(b, a, "interop::b_to_a", at_a, 8)
-        assert at_b[0].a == 7 and at_a[0].a == 8
+        yield ipc
     finally:
         gobyd.stop()
         shutil.rmtree(ipc_dir, ignore_errors=True)
 
 
-def test_real_goby_zeromq_publish_and_subscribe_on_our_broker(tmp_path) -> None:
-    reason = real_goby_skip_reason("goby")
-    if reason:
-        pytest.skip(reason)
+@contextlib.contextmanager
+def _our_broker(tmp_path: Path) -> Iterator[InterProcessPortalConfig]:
     ipc_dir = short_ipc_dir()
     broker = BrokerProcess(ipc_dir, platform="interop", log_path=tmp_path / "broker.log")
     broker.start()
     try:
-        ipc = broker.interprocess_config()
-        # Goby -> us: `goby zeromq publish GROUP TYPE VALUE` (type with "protobuf." implies PROTOBUF)
+        yield broker.interprocess_config()
+    finally:
+        broker.stop()
+        shutil.rmtree(ipc_dir, ignore_errors=True)
+
+
+def test_our_clients_talk_both_ways_through_a_real_gobyd(tmp_path: Path) -> None:
+    reason = real_goby_skip_reason("gobyd")
+    if reason:
+        pytest.skip(reason)
+    with _real_gobyd(tmp_path) as ipc, PortalClient(ipc, "ours_a") as a, PortalClient(ipc, "ours_b") as b:
+        at_b = b.collect("interop::a_to_b", Sample)
+        at_a = a.collect("interop::b_to_a", Sample)
+        assert a.wait_subscribed() and b.wait_subscribed()  # the manager handshake with gobyd worked
+        assert _ping_until_received(a, b, "interop::a_to_b", at_b, 7), (tmp_path / "gobyd.log").read_text()
+        assert _ping_until_received(b, a, "interop::b_to_a", at_a, 8)
+    assert at_b[0].a == 7 and at_a[0].a == 8
+
+
+@pytest.mark.parametrize("broker", ["goby-broker", "gobyd"])
+def test_real_goby_zeromq_publish_and_subscribe_with_our_client(tmp_path: Path, broker: str) -> None:
+    """The real tools and our client, both ways, on our broker and on a real gobyd."""
+    reason = real_goby_skip_reason("goby", *(["gobyd"] if broker == "gobyd" else []))
+    if reason:
+        pytest.skip(reason)
+    with (_real_gobyd if broker == "gobyd" else _our_broker)(tmp_path) as ipc:
+        # Goby -> us: `goby zeromq publish GROUP TYPE VALUE` (a type containing "protobuf." implies PROTOBUF)
         with PortalClient(ipc, "ours_sub") as ours:
             got = ours.collect("interop::helm", HelmStateReport)
             assert ours.wait_subscribed()
@@ -86,13 +105,10 @@ def test_real_goby_zeromq_publish_and_subscribe_on_our_broker(tmp_path) -> None:
                     if line:
                         break
             assert line is not None, (tmp_path / "sub.log").read_text()
-            fields = [f.strip() for f in line.split(" | ")]
-            assert fields[0] == str(int(Scheme.PROTOBUF))
-            assert fields[1] == "interop::status"
-            assert fields[2] == "goby.middleware.frontseat.protobuf.InterfaceStatus"
-            assert "INTERFACE_COMMAND" in fields[-1]
         finally:
             subscriber.stop()
-    finally:
-        broker.stop()
-        shutil.rmtree(ipc_dir, ignore_errors=True)
+    fields = [f.strip() for f in line.split(" | ")]
+    assert fields[0] == str(int(Scheme.PROTOBUF))
+    assert fields[1] == "interop::status"
+    assert fields[2] == "goby.middleware.frontseat.protobuf.InterfaceStatus"
+    assert "INTERFACE_COMMAND" in fields[-1]
