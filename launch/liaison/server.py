@@ -124,6 +124,7 @@ class WebServer:
                 log.exception("the web server failed")
         finally:
             loop.run_until_complete(loop.shutdown_asyncgens())
+            loop.run_until_complete(loop.shutdown_default_executor())  # aiohttp reads static files on it
             loop.close()
 
     async def _serve(self) -> None:
