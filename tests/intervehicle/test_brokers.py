@@ -85,7 +85,7 @@ def test_three_vehicles_on_the_acomms_link(fleet) -> None:
     sent = usv.collect(iv_groups.modem_transmit_result, ModemTransmissionWithLinkID)
     got: dict[str, list[NavigationReport]] = {"auv1": [], "auv2": []}
     commands: dict[str, list[AUVCommand]] = {"auv1": [], "auv2": []}
-    subscribed: list[int] = []
+    subscribed: set[tuple[str, str, int]] = set()
     for name, client in (("auv1", auv1), ("auv2", auv2)):
         cfg = TransporterConfig()
         cfg.intervehicle.publisher_id.append(USV)
@@ -94,14 +94,16 @@ def test_three_vehicles_on_the_acomms_link(fleet) -> None:
         cfg.intervehicle.buffer.newest_first = True
         client.intervehicle().subscribe(usv_nav, NavigationReport, got[name].append,
                                         Subscriber(cfg=cfg, group=nav_group,
-                                                   on_subscribed=lambda s, a: subscribed.append(a.header.src)))
+                                                   on_subscribed=lambda s, a, n=name: subscribed.add(
+                                                       (n, "nav", a.header.src))))
         ccfg = TransporterConfig()
         ccfg.intervehicle.publisher_id.append(USV)
         ccfg.intervehicle.buffer.ack_required = True
-        client.intervehicle().subscribe(auv_command, AUVCommand, commands[name].append, Subscriber(cfg=ccfg))
+        client.intervehicle().subscribe(auv_command, AUVCommand, commands[name].append, Subscriber(
+            cfg=ccfg, on_subscribed=lambda s, a, n=name: subscribed.add((n, "command", a.header.src))))
     # Four subscriptions reach the USV in the AUVs' slots (acked by the USV at once).
     assert poll_all(fleet[1], lambda: len(subscribed) == 4, 30), subscribed
-    assert set(subscribed) == {USV}
+    assert {src for _, _, src in subscribed} == {USV}
     acks: list[tuple[int, int]] = []
     expires: list = []
     publisher = Publisher(set_group=set_usv)
@@ -120,9 +122,12 @@ def test_three_vehicles_on_the_acomms_link(fleet) -> None:
     frames = [m.data for m in sent if m.data.type == m.data.DATA]
     assert frames and max(len(f) for m in frames for f in m.frame) <= 128
     assert all(m.dest in (0, AUV1 - 256, AUV2 - 256) for m in frames)  # one destination per transmission
-    # The USV's slots: every 20 s warped, scheduled and as measured here (real time x warp) within 5 %.
+    # The USV's slots: every 20 s warped as scheduled, and as measured here (arrival time x warp): on average
+    # within 5 % (each one within 25 %: a loaded machine delays single deliveries by tens of milliseconds).
     scheduled = [m.data.time / 1e6 for _, m in initiated]
+    gaps = [b - a for a, b in zip(scheduled, scheduled[1:], strict=False)]
+    assert len(gaps) >= 3 and all(g == pytest.approx(20.0) for g in gaps), gaps
     measured = [t * WARP for t, _ in initiated]
-    for starts in (scheduled, measured):
-        gaps = [b - a for a, b in zip(starts, starts[1:], strict=False)]
-        assert len(gaps) >= 3 and all(g == pytest.approx(20.0, rel=0.05) for g in gaps), gaps
+    gaps = [b - a for a, b in zip(measured, measured[1:], strict=False)]
+    assert (measured[-1] - measured[0]) / len(gaps) == pytest.approx(20.0, rel=0.05), gaps
+    assert all(g == pytest.approx(20.0, rel=0.25) for g in gaps), gaps

@@ -119,6 +119,7 @@ class Link:
         self._publisher_cfgs: dict[BufferId, list[DynamicBufferConfig]] = {}
         self._subscriber_cfgs: dict[tuple[int, BufferId], list[TransporterConfig]] = {}
         self._subscriptions: dict[tuple[int, BufferId], Subscription] = {}
+        self._forwarded: dict[tuple[int, int, bytes, tuple[int, ...]], int] = {}
         self._pending_ack: dict[int, list[tuple[int, BufferId, Value]]] = {}
         self._slot_srcs = {slot.src for slot in cfg.mac.slot}
         mac_cfg = type(cfg.mac)()
@@ -211,9 +212,17 @@ class Link:
                 self._expire(dropped, dest, ExpireData.EXPIRED_BUFFER_OVERFLOW, now)
 
     def forward_subscription(self, sub: Subscription) -> None:
-        """A local subscription from ``modem_subscription_forward_tx`` (Goby's ``_forward_subscription``)."""
+        """A local subscription from ``modem_subscription_forward_tx`` (Goby's ``_forward_subscription``).
+
+        One already forwarded by this link (same type, group, config and action) is not sent again: applications
+        resend theirs when a link announces itself, and only a restarted link needs them.
+        """
         if sub.HasField("metadata"):
             self._load(sub.metadata.protobuf_name, sub.metadata)
+        key = (sub.dccl_id, sub.group, sub.intervehicle.SerializeToString(), tuple(sub.header.dest))
+        if self._forwarded.get(key) == sub.action:
+            return
+        self._forwarded[key] = sub.action
         outgoing = Subscription()
         outgoing.CopyFrom(sub)
         outgoing.header.src = self.broadcast_id if sub.intervehicle.broadcast else self.modem_id
