@@ -17,3 +17,10 @@ def percentile(values: Sequence[float], q: float) -> float:
 def median_p99(values: Sequence[float]) -> tuple[float, float]:
     """(median, p99) of ``values``."""
     return statistics.median(values), percentile(values, 0.99)
+
+
+def markdown_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    """A Markdown table (pasteable into docs), columns padded to their widest cell."""
+    widths = [max(len(str(c)) for c in column) for column in zip(header, *rows)]
+    lines = [header, ["-" * w for w in widths], *rows]
+    return "\n".join("| " + " | ".join(f"{str(c):<{w}}" for c, w in zip(line, widths)) + " |" for line in lines)

@@ -139,12 +139,13 @@ class ProcessGroup:
             name = f"{base}.{n}"
         return name
 
-    def _spawn(self, entry: LaunchEntry) -> ManagedProcess:
+    def _spawn(self, entry: LaunchEntry, name: str | None = None) -> ManagedProcess:
         env = entry.environment(self.base_env)
-        name = self._unique_name(entry, env)
+        respawn = name is not None
+        name = name or self._unique_name(entry, env)
         self.log_dir.mkdir(parents=True, exist_ok=True)
         log_path = self.log_dir / f"{name}.log"
-        log_file = open(log_path, "wb")  # closed when the process is reaped
+        log_file = open(log_path, "ab" if respawn else "wb")  # closed when the process is reaped
         # `exec` makes the program itself the pid we signal; bash cannot exec an assignment prefix.
         script = entry.command if _ASSIGNMENT.match(entry.command) else f"exec {entry.command}"
         if self.preamble:
@@ -216,6 +217,24 @@ class ProcessGroup:
 
     def running(self) -> list[ManagedProcess]:
         return [p for p in self.processes if p.running]
+
+    def respawn(self, process: ManagedProcess) -> ManagedProcess:
+        """Start a process that ended again, same entry and name (its log is appended to); returns the new one.
+
+        For supervisors that restart what dies (the chaos soak, bench/bench_chaos.py); the launcher itself
+        stops everything when one process dies, as goby_launch does.
+        """
+        if process.running:
+            raise LaunchError(f"{process.name} is still running; stop it before respawning it")
+        process.popen.wait()
+        self._signal(process, signal.SIGKILL)  # helpers left in its group (process substitution)
+        self._close(process)
+        index = self.processes.index(process)
+        self.processes.remove(process)
+        new = self._spawn(process.entry, process.name)
+        self.processes.remove(new)
+        self.processes.insert(index, new)
+        return new
 
     def supervise(self, status_period_s: float = 5.0) -> int:
         """Watch the processes until stop_event is set, one dies, or all finish; then stop them all.

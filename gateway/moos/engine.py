@@ -386,7 +386,7 @@ class ClientEngine:
 
     def _report_undelivered(self, batches: Iterable[list[bytes]]) -> None:
         """Count and hand over messages that were accepted but may not have reached the DB."""
-        messages = [m for batch in batches for m in PacketReader().feed(frame_packet(batch))[0]]
+        messages = [m for batch in batches for m in PacketReader(2**31 - 1).feed(frame_packet(batch))[0]]
         self._undelivered += len(messages)
         func = self._on_undelivered
         if func is not None and messages:

@@ -55,6 +55,8 @@ LAYER = "interprocess"
 HOLD_REQUEST_PERIOD_S = 0.1
 #: How long ``publish`` waits for room when the PUB queue toward the broker is full before dropping (logged).
 SEND_BLOCK_S = 1.0
+IN_DOUBT_S = 0.5  # publications this recent when the broker connection drops may have died with it
+RESUBSCRIBE_SETTLE_S = 0.5  # after a reconnection, time for the subscribers' subscriptions to reach our PUB
 RECV_BATCH = 512
 HEAD_CACHE_SIZE = 4096  # distinct identifiers remembered as already validated
 
@@ -99,6 +101,11 @@ class InterProcessPortal:
         self._closed = False
         self.dropped = 0
         self.malformed = 0
+        self.refused = 0  # publications refused because the broker connection was down (publish returned False)
+        self.in_doubt = 0  # publications reported undelivered: sent just before the connection dropped
+        self.on_undelivered: Callable[[list[tuple[str, bytes]]], None] | None = None
+        self._recent: deque[tuple[float, str, bytes]] = deque()  # (sent at, group, payload), the last IN_DOUBT_S
+        self._settle_until = 0.0
         zctx = context.zmq_context
         self._pub_endpoint, self._sub_endpoint, _ = request_endpoints(zctx, self._cfg, context.client_name)
         self._pub = zctx.socket(zmq.PUB)
@@ -129,17 +136,20 @@ class InterProcessPortal:
                   thread_name, self._pub_endpoint, self._sub_endpoint, self._primary)
 
     # ----------------------------------------------------------------------------------------- publish
-    def publish(self, group: GroupLike, msg: Any, *, scheme: int | None = None, record: bool = True) -> None:
+    def publish(self, group: GroupLike, msg: Any, *, scheme: int | None = None, record: bool = True) -> bool:
         """Serialize ``msg`` and send it to every subscriber of (group, type) in all processes, this one included.
 
         ``record=False``: the call is made by a transporter on behalf of another layer (intervehicle), which records
         its own call; the interface registry does not list it as an interprocess publication.
+        Returns False (and counts it in ``refused``, logged) when the broker connection is down, so it cannot go
+        to other processes; this process's own subscribers still get it. See docs/portal.md "Broker restart".
         """
         self._check_open()
         group_text = self._group_text(group)
         sch, tname, key = self._type_info(type(msg), scheme)
-        self._publish_frame(group_text, sch, tname, serialize(msg, sch, self._ctx.dccl), record)
+        sent = self._publish_frame(group_text, sch, tname, serialize(msg, sch, self._ctx.dccl), record)
         self._ctx.interthread.deliver(group_text, key, msg, self._mailbox)
+        return sent
 
     def _group_text(self, group: GroupLike) -> str:
         """The validated wire string of ``group`` (cached: publishing is the hot path)."""
@@ -159,14 +169,14 @@ class InterProcessPortal:
             info = self._types[(msg_type, scheme)] = (sch, type_name(msg_type, sch), type_key(msg_type))
         return info
 
-    def publish_serialized(self, group: GroupLike, scheme: int, type_name_: str, payload: bytes) -> None:
-        """Send an already-encoded payload (gateways relaying data whose class is not imported)."""
+    def publish_serialized(self, group: GroupLike, scheme: int, type_name_: str, payload: bytes) -> bool:
+        """Send an already-encoded payload (gateways relaying data whose class is not imported); as ``publish``."""
         self._check_open()
         grp = as_group(group)
         check_named(grp, "InterProcess")
-        self._publish_frame(str(grp), int(scheme), type_name_, payload)
+        return self._publish_frame(str(grp), int(scheme), type_name_, payload)
 
-    def _publish_frame(self, group: str, scheme: int, tname: str, payload: bytes, record: bool = True) -> None:
+    def _publish_frame(self, group: str, scheme: int, tname: str, payload: bytes, record: bool = True) -> bool:
         key = (group, scheme, tname)
         ident = self._identifiers.get(key)
         if ident is None:
@@ -175,12 +185,23 @@ class InterProcessPortal:
             if record:
                 self._record("publish", group, scheme, tname)
         frame = encode_frame(ident, payload)
-        if self._ctx.hold_released:
-            if self._held:
-                self._flush_held()
-            self._send(frame)
-        else:
+        if not self._ctx.hold_released:
             self._held.append(frame)
+            return True
+        now = time.monotonic()
+        if self._disconnected or now < self._settle_until:
+            self.refused += 1
+            if self.refused == 1 or self.refused % 100 == 0:
+                log.error("%s: publication on %s refused: the broker connection is down (%d refused so far)",
+                          self._thread_name, group, self.refused)
+            return False
+        if self._held:
+            self._flush_held()
+        recent = self._recent
+        recent.append((now, group, payload))
+        while recent[0][0] < now - IN_DOUBT_S:
+            recent.popleft()
+        return self._send(frame)
 
     def _send(self, frame: bytes) -> bool:
         try:
@@ -453,6 +474,7 @@ class InterProcessPortal:
             kind = event["event"]
             if kind == zmq.EVENT_DISCONNECTED:
                 self._disconnected = True
+                self._report_in_doubt()
                 if self._cfg.transport == InterProcessPortalConfig.TCP:
                     self._requery_at = time.monotonic() + 1.0
                 log.warning("%s: lost connection to the broker (%s); ZeroMQ will reconnect and resubscribe",
@@ -461,9 +483,26 @@ class InterProcessPortal:
                 if self._disconnected:
                     log.warning("%s: reconnected to the broker (%s); %d subscription(s) restored",
                                 self._thread_name, self._sub_endpoint, len(self._subs) + len(self._regex))
+                    self._settle_until = time.monotonic() + RESUBSCRIBE_SETTLE_S
                 self._disconnected = False
                 self._ever_connected = True
                 self._requery_at = None
+
+    def _report_in_doubt(self) -> None:
+        """The connection dropped: what was sent in the last IN_DOUBT_S may have died in the broker."""
+        cutoff = time.monotonic() - IN_DOUBT_S
+        lost = [(group, payload) for sent_at, group, payload in self._recent if sent_at >= cutoff]
+        self._recent.clear()
+        if not lost:
+            return
+        self.in_doubt += len(lost)
+        log.warning("%s: %d publication(s) sent in the last %.1f s before the broker connection dropped may be "
+                    "lost; reported undelivered", self._thread_name, len(lost), IN_DOUBT_S)
+        if self.on_undelivered is not None:
+            try:
+                self.on_undelivered(lost)
+            except Exception:
+                log.exception("%s: on_undelivered callback raised", self._thread_name)
 
     # ---------------------------------------------------------------------------------------- misc
     def _record(self, direction: str, group: str, scheme: int, tname: str) -> None:

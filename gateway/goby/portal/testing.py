@@ -252,8 +252,8 @@ class PortalClient:
             raise
         self.portal.ready()
 
-    def publish(self, group: GroupLike, msg: Any, **kwargs: Any) -> None:
-        self.portal.publish(group, msg, **kwargs)
+    def publish(self, group: GroupLike, msg: Any, **kwargs: Any) -> bool:
+        return self.portal.publish(group, msg, **kwargs)
 
     def subscribe(self, group: GroupLike, msg_type: type, callback: Callable[[Any], None], **kwargs: Any) -> None:
         """``callback`` runs on the test's thread inside :meth:`poll`."""
