@@ -298,7 +298,7 @@ def report(kills: list[Kill], probes: tuple[MoosProbe, PortalProbe], rss_start: 
         cells.append(f"{start:.0f} → {end:.0f}" if start and end else "-")
         rows.append(cells)
     totals = []
-    for label, probe in zip(("MOOS", "interprocess"), probes):
+    for label, probe in zip(("MOOS", "interprocess"), probes, strict=True):
         ledger = probe.ledger
         with ledger.lock:
             sent, delivered = len(ledger.sent), len(ledger.delivered)

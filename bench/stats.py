@@ -21,6 +21,6 @@ def median_p99(values: Sequence[float]) -> tuple[float, float]:
 
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     """A Markdown table (pasteable into docs), columns padded to their widest cell."""
-    widths = [max(len(str(c)) for c in column) for column in zip(header, *rows)]
+    widths = [max(len(str(c)) for c in column) for column in zip(header, *rows, strict=True)]
     lines = [header, ["-" * w for w in widths], *rows]
-    return "\n".join("| " + " | ".join(f"{str(c):<{w}}" for c, w in zip(line, widths)) + " |" for line in lines)
+    return "\n".join("| " + " | ".join(f"{str(c):<{w}}" for c, w in zip(line, widths, strict=True)) + " |" for line in lines)

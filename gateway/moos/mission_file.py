@@ -98,7 +98,7 @@ class MissionFile:
     def _global(self, name: str) -> tuple[str, int] | None:
         """(value, line number) of global ``name``, or None."""
         wanted = name.strip().lower()
-        for line, number in zip(self._lines, self._numbers):
+        for line, number in zip(self._lines, self._numbers, strict=True):
             squeezed = _WHITESPACE.sub("", line)
             token, sep, value = squeezed.partition("=")
             if sep and token.lower() == wanted:

@@ -159,14 +159,14 @@ def test_good_clients_unaffected_by_slow_readers_and_partial_packets(tmp_path: P
             # A gap the DB caused is a growth of latency between consecutive messages; one the sender caused
             # (this process starved of CPU on a loaded machine) is not, so it is measured against send times.
             latency = [t - sent_at[n] for t, n in got]
-            gaps = [b - a for a, b in zip(latency, latency[1:])]
+            gaps = [b - a for a, b in zip(latency, latency[1:], strict=False)]
             worst[key] = max(gaps)
             assert max(gaps) < 0.2, f"{key}: the DB held good messages back {max(gaps) * 1000:.0f} ms"
         assert attack.slow >= 10 and attack.partial >= 5
         assert "not keeping up: outbox full" in log and "slow" in log
         assert "max_buffered_bytes" in log and "partial" in log
         assert "pausing" not in log
-        print(f"max gaps {[round(max(b[0] - a[0] for a, b in zip(g, g[1:])) * 1000) for g in arrivals.values()]} ms "
+        print(f"max gaps {[round(max(b[0] - a[0] for a, b in zip(g, g[1:], strict=False)) * 1000) for g in arrivals.values()]} ms "
               f"(caused by the DB {[round(w * 1000) for w in worst.values()]} ms), "
               f"RSS {rss_start >> 20} -> peak {peak[0] >> 20} -> end {rss_end >> 20} MiB, slow {attack.slow}, partial {attack.partial}")
         assert peak[0] - rss_start < TOTAL_CAP + RSS_SLACK, (rss_start, peak[0])
