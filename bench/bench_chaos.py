@@ -92,9 +92,18 @@ class MoosProbe:
         self._sub.set_on_mail_callback(self._on_mail)
         self._pub = comms(clock=MoosClock(warp))
         self._pub.set_on_undelivered_callback(self._on_undelivered)
+        # After a moos-db restart the queued numbers go once the reader is back (MOOS keeps no mail for a
+        # client that has not registered yet, so otherwise they would be confirmed to nobody).
+        self._pub.set_on_connect_callback(self._reader_back)
         self._sub.run("127.0.0.1", port, "uChaosSub")
         self._pub.run("127.0.0.1", port, "uChaosPub")
         self._thread = threading.Thread(target=self._publish, name="chaos-moos-probe", daemon=True)
+
+    def _reader_back(self) -> None:
+        deadline = time.monotonic() + 30
+        while not self._sub.is_connected() and time.monotonic() < deadline and not self._stop.is_set():
+            time.sleep(0.05)
+        time.sleep(0.3)  # its registration is written right after it connects
 
     def _on_mail(self) -> None:
         for msg in self._sub.fetch():
