@@ -172,7 +172,7 @@ class PortalProbe:
 
     def _on_undelivered(self, lost: list[tuple[str, bytes]]) -> None:
         with self.ledger.lock:
-            self.ledger.reported.update(int(payload) for group, payload in lost if group == "chaos_probe")
+            self.ledger.reported.update(int(payload.rstrip(b"\0")) for group, payload in lost if group == "chaos_probe")
 
     def _publish(self) -> None:
         self._ready.wait(30)

@@ -23,7 +23,7 @@ def test_broker_crash_accounting_is_exact(tmp_path: Path) -> None:
         with PortalClient(cfg, "reader") as reader, PortalClient(cfg, "writer") as writer:
             reader.subscribe("seq", str, lambda text: delivered.append(int(text)))
             assert reader.wait_subscribed() and writer.wait_ready()
-            writer.portal.on_undelivered = lambda lost: reported.extend(int(p) for g, p in lost if g == "seq")
+            writer.portal.on_undelivered = lambda lost: reported.extend(int(p.rstrip(b"\0")) for g, p in lost if g == "seq")
             for i in range(N):
                 if i == N // 3:
                     broker.kill()
