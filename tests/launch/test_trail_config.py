@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 from google.protobuf import text_format
@@ -241,3 +242,23 @@ def test_trail_deployment_is_generated_from_the_code():
     assert list(deployment.platforms) == ["topside", "usv", "auv0", "auv1", "auv2", "auv3"]
     usv_apps = set(deployment.platforms["usv"].modules["nomodule"].applications)
     assert {"usv-manager", "frontseat-interface", "moos-gateway"} <= usv_apps
+
+
+def test_a_death_inside_a_nested_launch_is_named_by_both_launchers_and_everything_stops(tmp_path):
+    inner = tmp_path / "inner.launch"
+    inner.write_text(f"[name=${{GOBY_LAUNCH_PLATFORM}}.sleeper] {sys.executable} -c \"import time; time.sleep(600)\"\n"
+                     f"[name=${{GOBY_LAUNCH_PLATFORM}}.crasher] bash -c 'sleep 2; echo boom; exit 3'\n")
+    outer = tmp_path / "outer.launch"
+    outer.write_text("[name=vehicle] goby-launch -P -d 10 --startup-check 0.2 -p one ${GOBY_LAUNCH_DIR}/inner.launch\n"
+                     "[name=other] goby-launch -P -d 10 -p two ${GOBY_LAUNCH_DIR}/inner.launch\n")
+    logs = tmp_path / "logs"
+    run = subprocess.run([sys.executable, "-m", "launch.apps.goby_launch", "-P", "-d", "10", "--startup-check", "0.2",
+                          "-L", str(logs), str(outer)], capture_output=True, text=True, timeout=120, cwd="/")
+    output = run.stdout + run.stderr
+    assert run.returncode == 1, output
+    # the outer launcher names the platform and shows the inner one's report: the process, its status, its log tail
+    assert re.search(r"\] \d\d:\d\d:\d\d: (vehicle|other) died unexpectedly \(exit status 1\)", output), output
+    assert re.search(r"(one|two)\.crasher died unexpectedly \(exit status 3\)", output) and "boom" in output, output
+    sleepers = [int(pid) for path in logs.rglob("*.log")
+                for pid in re.findall(r"^Launched \((\d+)\) \w+\.sleeper", path.read_text(), flags=re.M)]
+    assert sleepers and not any(Path(f"/proc/{pid}").exists() for pid in sleepers), sleepers
