@@ -203,6 +203,8 @@ class ShoreOperator(SingleThreadApplication):
 
     def loop(self) -> None:
         """Publish every command whose time has come. Runs on the main thread at 2 Hz (times warp)."""
+        if self._satellite is not None:
+            self._satellite.service()
         while self._t0 is not None and self._plan and self._plan[0].at <= self._sim_elapsed():
             planned: ScheduledCommand = self._plan.pop(0)
             try:

@@ -79,7 +79,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
     )
     out = OutputReader(proc)
     try:
-        out.wait_for(r"All processes running \(10\)")
+        out.wait_for(r"All processes running \(11\)")
         helm_pid = int(out.wait_for(r"^Launched \((\d+)\) usv\.helm:").group(1))
         moosdb_log = tmp_path / "logs" / "usv.moosdb.log"
         deadline = time.monotonic() + 60  # ten Python processes starting at once: the DB may still be importing
@@ -95,7 +95,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
     assert proc.returncode == 1, text
     assert "usv.helm died unexpectedly (exit status -9)" in text
     pids = [int(p) for p in re.findall(r"^Launched \((\d+)\)", text, flags=re.M)]
-    assert len(pids) == 10
+    assert len(pids) == 11
     assert not any(_alive(pid) for pid in pids), text
     logs = sorted(p.name for p in (tmp_path / "logs").iterdir())
     assert "usv.frontseat-interface.log" in logs and "usv.shore.log" in logs
@@ -121,7 +121,7 @@ def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(
         out.finish()
     assert proc.returncode == 0, text
     assert "=== USV mission summary" in text
-    assert "processes: 10/10 exited cleanly" in text
+    assert "processes: 11/11 exited cleanly" in text
     assert "1. t=" in text and "POLYGON_UPDATES=polygon=radial::x=0,y=0,radius=200,pts=6" in text
     rows = list(csv.DictReader(open(out_dir / "track.csv")))
     assert len(rows) > 50
@@ -216,7 +216,7 @@ def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(t
     assert re.search(r"^  1\. t=\d+ s: DEPLOY_STATE=WAYPOINTS$", text, flags=re.M), text
     assert "  2. t=" not in text and "acknowledgements: 1 posted to MOOS, 0 refused" in text, text
     assert re.search(r"^waypoints phase t=\d+\.\.\d+ s \(\d+ s, until the end of the run\)", text, flags=re.M), text
-    assert "processes: 10/10 exited cleanly" in text
+    assert "processes: 11/11 exited cleanly" in text
     shore_log = (out_dir / "run" / "logs" / "usv.shore.log").read_text()
     assert "no commands planned" in shore_log and "sent " not in shore_log, shore_log
     headings = [float(h) for h in re.findall(r"hdg=\s*([-\d.]+)", text)]

@@ -90,8 +90,10 @@ class CommandSender(SingleThreadApplication):
         self._command = command
         self._deadline = time.monotonic() + timeout_s
         self._timeout_s = timeout_s
+        self._satellite: SatelliteCommander | None = None
         if cfg.intervehicle:
-            SatelliteCommander(self, self._on_ack).send(command)
+            self._satellite = SatelliteCommander(self, self._on_ack)
+            self._satellite.send(command)
         else:
             self.interprocess().subscribe(groups.usv_command_ack, USVCommandAck, self._on_ack)
             # Buffered until the broker releases the hold, so it cannot overtake our ack subscription.
@@ -111,7 +113,9 @@ class CommandSender(SingleThreadApplication):
             self.quit(EXIT_UNACKNOWLEDGED)
 
     def loop(self) -> None:
-        """Give up at the deadline. Runs on the main thread at 10 Hz."""
+        """Send once the hold is released (intervehicle); give up at the deadline. Runs on the main thread at 10 Hz."""
+        if self._satellite is not None:
+            self._satellite.service()
         if time.monotonic() >= self._deadline:
             print(f"NOT acknowledged within {self._timeout_s:g} s (is usv-manager running, and moos-gateway "
                   "with the usv_command plugin?)", flush=True)

@@ -51,12 +51,26 @@ class SatelliteCommander:
         self._thread = thread
         self._report = report
         self._sent: dict[bytes, _Sent] = {}
+        self._queue: list[USVCommand] = []
         thread.context.dccl.load(USVCommand)
         thread.interprocess().subscribe(iv_groups.modem_transmit_result, ModemTransmissionWithLinkID,
                                         self._on_transmit)
 
     def send(self, command: USVCommand) -> None:
-        """Publish ``command`` (its ``time`` identifies it) on the course's usv_command group."""
+        """Publish ``command`` (its ``time`` identifies it) on the course's usv_command group, once the start-up
+        hold is released (call :meth:`service` from the thread's loop): a held publication would count the hold
+        as slot wait."""
+        self._queue.append(command)
+        self.service()
+
+    def service(self) -> None:
+        """Send what waited for the hold; call it from the owning thread's ``loop()``."""
+        if self._thread.interprocess().hold_state():
+            return
+        while self._queue:
+            self._send_now(self._queue.pop(0))
+
+    def _send_now(self, command: USVCommand) -> None:
         data = self._thread.context.dccl.encode(command)
         self._sent[data] = _Sent(command, self._thread.context.clock.now())
         self._thread.intervehicle().publish(
