@@ -262,8 +262,8 @@ def run(args: argparse.Namespace) -> int:
                                  and (not args.victims or any(v in p.name for v in args.victims.split(",")))])
             kill = Kill(victim.name, time.monotonic())
             kills.append(kill)
-            victim.popen.send_signal(signal.SIGKILL)
-            victim.popen.wait(10)
+            victim.child.send_signal(signal.SIGKILL)
+            victim.child.wait(10)
             process = group.respawn(victim)
             _wait_recovered(mission, probes, process, kill)
             took = f"{kill.recovered_at - kill.at:.1f} s" if kill.recovered_at else "NOT recovered"

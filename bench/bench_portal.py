@@ -19,7 +19,7 @@ from pathlib import Path
 from google.protobuf import text_format
 
 from bench.stats import median_p99
-from gateway.goby.portal.testing import AppProcess, BrokerProcess, PortalClient
+from gateway.goby.portal.testing import BrokerProcess, PortalClient, app_process
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from tests.protobuf.sample_messages_pb2 import Sample, Widget
 
@@ -178,10 +178,10 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="gbb", dir="/tmp") as tmp, \
             BrokerProcess(Path(tmp), platform="bench") as broker:
         cfg_text = broker.interprocess_text()
-        with AppProcess([sys.executable, "-m", "bench.bench_portal", "--child", cfg_text],
-                        cwd=str(Path(__file__).resolve().parents[1])) as sub, \
+        with app_process([sys.executable, "-m", "bench.bench_portal", "--child", cfg_text], Path(tmp) / "sub.log",
+                         cwd=str(Path(__file__).resolve().parents[1])) as sub, \
                 PortalClient(broker.interprocess_config(), "bench_pub", hold_settle_s=0.0) as client:
-            if sub.wait_for("CHILD READY", 60) is None:
+            if sub.wait_for_output("CHILD READY", 60) is None:
                 print("subscriber did not start", file=sys.stderr)
                 return 1
             bench = Bench(client)

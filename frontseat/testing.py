@@ -4,91 +4,60 @@
   and stops it on exit;
 * :class:`SimClient` is a blocking line client for talking to it byte for byte;
 * :func:`basic_simulator_frontseat_cfg` writes the interface's ``frontseat_cfg`` for it;
-* :func:`wait_until` polls a condition (never assert on a fixed sleep).
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
-import selectors
+import shutil
 import socket
-import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import TypeVar
+from pathlib import Path
 
-T = TypeVar("T")
+from util.process import ChildProcess, ProcessError
 
 DELIMITER = b"\r\n"
 
 
-def wait_until(condition: Callable[[], T], timeout: float = 20.0, interval: float = 0.02, what: str = "") -> T:
-    """Poll ``condition`` until it returns something truthy (returned); AssertionError after ``timeout`` s."""
-    deadline = time.monotonic() + timeout
-    while True:
-        value = condition()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what or condition}")
-        time.sleep(interval)
-
-
-def free_tcp_port() -> int:
-    """A port that was free a moment ago on 127.0.0.1."""
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
 @dataclass
 class SimulatorProcess:
-    """A running ``frontseat-sim`` subprocess."""
+    """A running ``frontseat-sim`` child process and the address it listens on."""
 
-    process: subprocess.Popen[str]
+    process: ChildProcess
     host: str
     port: int
+    _own_dir: str | None = None
 
     def stop(self, kill: bool = False) -> None:
         """SIGTERM (or SIGKILL) it and wait; idempotent."""
-        if self.process.poll() is None:
-            self.process.kill() if kill else self.process.terminate()
-            try:
-                self.process.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait(timeout=10)
-        if self.process.stdout is not None:
-            self.process.stdout.close()
+        if kill:
+            self.process.kill()
+        self.process.stop()
+        if self._own_dir is not None:
+            shutil.rmtree(self._own_dir, ignore_errors=True)
+            self._own_dir = None
 
 
-def start_simulator(port: int = 0, verbosity: int = 0, timeout: float = 30.0) -> SimulatorProcess:
-    """Start ``python -m frontseat.simulator.server <port>`` and wait until it listens."""
+def start_simulator(port: int = 0, verbosity: int = 0, timeout: float = 30.0,
+                    log_path: str | os.PathLike[str] | None = None) -> SimulatorProcess:
+    """Start ``frontseat-sim <port>`` (0: a free port) and wait until it listens; its output goes to ``log_path``
+    (default: a temporary file removed when it stops)."""
     args = [sys.executable, "-m", "frontseat.apps.frontseat_sim", str(port)] + (["-" + "v" * verbosity] if verbosity else [])
-    process = subprocess.Popen(args, stdout=subprocess.PIPE, text=True, env=dict(os.environ, PYTHONUNBUFFERED="1"))
-    assert process.stdout is not None
-    line = ""
-    deadline = time.monotonic() + timeout
-    with selectors.DefaultSelector() as selector:  # never block past the deadline on a silent child
-        selector.register(process.stdout, selectors.EVENT_READ)
-        while time.monotonic() < deadline:
-            if not selector.select(timeout=0.2):
-                if process.poll() is not None:
-                    break
-                continue
-            line = process.stdout.readline()
-            if "listening on" in line or not line:
-                break
-    if "listening on" not in line:
-        process.kill()
-        process.wait(timeout=10)
-        process.stdout.close()
-        raise RuntimeError(f"frontseat-sim did not start (exit {process.returncode}, said {line!r})")
-    host, _, bound = line.rsplit(" ", 1)[1].strip().rpartition(":")
-    return SimulatorProcess(process, host, int(bound))
+    own_dir = None if log_path is not None else tempfile.mkdtemp(prefix="fsim", dir="/tmp")
+    child = ChildProcess(args, log_path or Path(own_dir or ".") / "frontseat-sim.log", name="frontseat-sim").start()
+    try:
+        ready = child.wait_ready(r"listening on (\S+):(\d+)", timeout=timeout)
+    except ProcessError:
+        if own_dir is not None:
+            shutil.rmtree(own_dir, ignore_errors=True)
+        raise
+    assert ready is not None
+    return SimulatorProcess(child, ready.group(1), int(ready.group(2)), own_dir)
 
 
 @contextlib.contextmanager

@@ -11,18 +11,16 @@ from __future__ import annotations
 import logging
 import os
 import re
-import signal
-import subprocess
 import sys
 import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO
 
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import LaunchEntry, expand_vars
+from util.process import ChildProcess, ProcessError
 
 log = logging.getLogger(__name__)
 
@@ -38,47 +36,45 @@ def _print(line: str) -> None:
 
 @dataclass
 class ManagedProcess:
-    """One launched entry: its process, log file and how it ended."""
+    """One launched entry: its child process (``util.process.ChildProcess``) and whether its end was reported."""
 
     name: str
     entry: LaunchEntry
-    log_path: Path
-    popen: subprocess.Popen[bytes]
-    log_file: IO[bytes]
+    child: ChildProcess
     started_at: float = field(default_factory=time.monotonic)
-    stop_requested: bool = False
-    killed: bool = False
     reported: bool = False
 
     @property
     def pid(self) -> int:
-        return self.popen.pid
+        return self.child.pid
+
+    @property
+    def log_path(self) -> Path:
+        return self.child.log_path
 
     @property
     def returncode(self) -> int | None:
-        return self.popen.poll()
+        return self.child.poll()
 
     @property
     def running(self) -> bool:
-        return self.popen.poll() is None
+        return self.child.running
+
+    @property
+    def stop_requested(self) -> bool:
+        return self.child.stop_requested
 
     @property
     def exited_cleanly(self) -> bool:
         """True once it ended on its own with status 0, or on our stop signal without needing SIGKILL."""
-        code = self.popen.poll()
-        if code is None or self.killed:
+        code = self.child.poll()
+        if code is None or self.child.killed:
             return False
-        return code == 0 or (self.stop_requested and code == -self.entry.kill_signal)
+        return code == 0 or (self.child.stop_requested and code == -self.entry.kill_signal)
 
     def log_tail(self, lines: int = 20) -> str:
         """The last lines of the process's log, for error reports."""
-        try:
-            self.log_file.flush()
-            text = self.log_path.read_text(errors="replace")
-        except OSError as exc:
-            return f"(log {self.log_path} unreadable: {exc})"
-        tail = text.splitlines()[-lines:]
-        return "\n".join(f"    {line}" for line in tail) if tail else "    (log is empty)"
+        return self.child.tail(lines)
 
 
 class ProcessGroup:
@@ -139,34 +135,23 @@ class ProcessGroup:
             name = f"{base}.{n}"
         return name
 
-    def _spawn(self, entry: LaunchEntry, name: str | None = None) -> ManagedProcess:
+    def _spawn(self, entry: LaunchEntry) -> ManagedProcess:
         env = entry.environment(self.base_env)
-        respawn = name is not None
-        name = name or self._unique_name(entry, env)
-        self.log_dir.mkdir(parents=True, exist_ok=True)
-        log_path = self.log_dir / f"{name}.log"
-        log_file = open(log_path, "ab" if respawn else "wb")  # closed when the process is reaped
+        name = self._unique_name(entry, env)
         # `exec` makes the program itself the pid we signal; bash cannot exec an assignment prefix.
         script = entry.command if _ASSIGNMENT.match(entry.command) else f"exec {entry.command}"
         if self.preamble:
             script = f"{self.preamble}\n{script}"
+        child = ChildProcess(["/bin/bash", "-c", script], self.log_dir / f"{name}.log", name=name, env=env,
+                             cwd=self.cwd, new_session=True)
         try:
-            popen = subprocess.Popen(
-                ["/bin/bash", "-c", script],
-                stdin=subprocess.DEVNULL,
-                stdout=log_file,
-                stderr=subprocess.STDOUT,
-                env=env,
-                cwd=self.cwd,
-                start_new_session=True,
-            )
-        except OSError as exc:
-            log_file.close()
+            child.start()
+        except ProcessError as exc:
             raise LaunchError(f"cannot start {name!r} ({entry.command}): {exc}") from exc
-        process = ManagedProcess(name=name, entry=entry, log_path=log_path, popen=popen, log_file=log_file)
+        process = ManagedProcess(name=name, entry=entry, child=child)
         self.processes.append(process)
-        self.report(f"Launched ({popen.pid}) {name}: {entry.command}")
-        log.info("launched %s pid %d, log %s", name, popen.pid, log_path)
+        self.report(f"Launched ({child.pid}) {name}: {entry.command}")
+        log.info("launched %s pid %d, log %s", name, child.pid, child.log_path)
         return process
 
     def start(self) -> None:
@@ -219,22 +204,22 @@ class ProcessGroup:
         return [p for p in self.processes if p.running]
 
     def respawn(self, process: ManagedProcess) -> ManagedProcess:
-        """Start a process that ended again, same entry and name (its log is appended to); returns the new one.
+        """Start a process that ended again, same entry and name (its log is appended to); returns it.
 
         For supervisors that restart what dies (the chaos soak, bench/bench_chaos.py); the launcher itself
         stops everything when one process dies, as goby_launch does.
         """
         if process.running:
             raise LaunchError(f"{process.name} is still running; stop it before respawning it")
-        process.popen.wait()
-        self._signal(process, signal.SIGKILL)  # helpers left in its group (process substitution)
-        self._close(process)
-        index = self.processes.index(process)
-        self.processes.remove(process)
-        new = self._spawn(process.entry, process.name)
-        self.processes.remove(new)
-        self.processes.insert(index, new)
-        return new
+        process.child.stop()  # reap it; helpers left in its group (process substitution) go too
+        try:
+            process.child.start()
+        except ProcessError as exc:
+            raise LaunchError(f"cannot start {process.name!r} ({process.entry.command}): {exc}") from exc
+        process.reported = False
+        process.started_at = time.monotonic()
+        self.report(f"Launched ({process.pid}) {process.name}: {process.entry.command}")
+        return process
 
     def supervise(self, status_period_s: float = 5.0) -> int:
         """Watch the processes until stop_event is set, one dies, or all finish; then stop them all.
@@ -280,43 +265,27 @@ class ProcessGroup:
 
     # -- shutdown -------------------------------------------------------------------------------
 
-    def _signal(self, process: ManagedProcess, sig: signal.Signals) -> None:
-        try:
-            os.killpg(process.pid, sig)
-        except ProcessLookupError:
-            pass
-        except PermissionError:
-            process.popen.send_signal(sig)
-
-    def _wait_or_kill(self, processes: Sequence[ManagedProcess]) -> None:
+    def _stop_all(self, processes: Sequence[ManagedProcess]) -> None:
+        """Signal each with its kill signal at once, then give them ``kill_timeout_s`` together before SIGKILL."""
+        for process in processes:
+            process.child.stop_requested = True
+            process.child.send_signal(process.entry.kill_signal)
         deadline = time.monotonic() + self.kill_timeout_s
         for process in processes:
-            try:
-                process.popen.wait(timeout=max(0.0, deadline - time.monotonic()))
-            except subprocess.TimeoutExpired:
-                self.report(
-                    f"WARNING: {process.name} ({process.pid}) did not respond to "
-                    f"{process.entry.kill_signal.name} after {self.kill_timeout_s:g} s, sending SIGKILL"
-                )
-                process.killed = True
-                self._signal(process, signal.SIGKILL)
-                process.popen.wait()
-            else:
-                # The program is gone; make sure helpers left in its group (process substitution) go too.
-                self._signal(process, signal.SIGKILL)
-            self._close(process)
+            self._stop_one(process, max(0.0, deadline - time.monotonic()))
 
-    def _close(self, process: ManagedProcess) -> None:
-        if not process.log_file.closed:
-            process.log_file.close()
+    def _stop_one(self, process: ManagedProcess, grace: float) -> None:
+        process.child.stop(grace=grace, sig=process.entry.kill_signal)
+        if process.child.killed:
+            self.report(f"WARNING: {process.name} ({process.pid}) did not respond to "
+                        f"{process.entry.kill_signal.name} after {self.kill_timeout_s:g} s, sending SIGKILL")
 
     def stop(self) -> None:
         """Stop every running process (reverse launch order, or all at once if parallel_stop)."""
         order = list(reversed(self.processes))
         for process in order:
             if not process.running:
-                process.popen.wait()
-                self._close(process)
+                process.child.stop()  # reap it and close its log
         live = [p for p in order if p.running]
         if not live:
             return
@@ -326,16 +295,11 @@ class ProcessGroup:
             # processes can still talk to them while they shut down.
             brokers = [p for p in live if p.entry.binary in BROKER_PROGRAMS]
             for wave in ([p for p in live if p not in brokers], brokers):
-                for process in wave:
-                    process.stop_requested = True
-                    self._signal(process, process.entry.kill_signal)
-                self._wait_or_kill(wave)
+                self._stop_all(wave)
         else:
             for process in live:
-                process.stop_requested = True
                 self.report(f"{process.entry.kill_signal.name}: {process.pid} (was {process.name})")
-                self._signal(process, process.entry.kill_signal)
-                self._wait_or_kill([process])
+                self._stop_one(process, self.kill_timeout_s)
         for process in live:
             verdict = "success" if process.exited_cleanly else f"exit status {process.returncode}"
             log.info("%s stopped: %s", process.name, verdict)

@@ -13,7 +13,6 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
-import subprocess
 import sys
 import threading
 from collections.abc import Iterable, Iterator
@@ -25,6 +24,7 @@ from gateway.moos_gateway.application import GobyMOOSGateway
 from gateway.moos_gateway.plugins import ENV_VAR, Plugin
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from translators.base import translator_plugin
+from util.process import ChildProcess
 
 
 def gateway_config(moos_port: int, interprocess: InterProcessPortalConfig | None = None,
@@ -72,46 +72,33 @@ def hosted_translators(cfg: GobyMOOSGatewayConfig, *translator_classes: type[Sim
 
 
 class GatewayProcess:
-    """``moos-gateway`` as a child process with ``GOBY_MOOS_GATEWAY_PLUGINS`` set; output goes to files."""
+    """``moos-gateway`` as a child process with ``GOBY_MOOS_GATEWAY_PLUGINS`` set; stdout in ``gateway.out``,
+    its log (stderr) in ``gateway.err``."""
 
     def __init__(self, workdir: str | os.PathLike[str], plugins: Iterable[str], config_text: str,
                  env: dict[str, str] | None = None, extra_args: Iterable[str] = ()) -> None:
         self.workdir = Path(workdir)
-        self.plugins = ":".join(plugins)
         self.config_path = self.workdir / "gateway.pb.cfg"
         self.config_path.write_text(config_text)
-        self.env = dict(os.environ if env is None else env)
-        self.env[ENV_VAR] = self.plugins
-        self.extra_args = list(extra_args)
-        self.proc: subprocess.Popen[bytes] | None = None
-        self.stdout_path = self.workdir / "gateway.out"
-        self.stderr_path = self.workdir / "gateway.err"
+        env = dict(os.environ if env is None else env)
+        env[ENV_VAR] = ":".join(plugins)
+        self.proc = ChildProcess([sys.executable, "-m", "gateway.apps.moos_gateway", str(self.config_path),
+                                  *extra_args], self.workdir / "gateway.out", name="moos-gateway",
+                                 env=env, cwd=self.workdir, stderr_path=self.workdir / "gateway.err")
 
     def start(self) -> GatewayProcess:
-        cmd = [sys.executable, "-m", "gateway.apps.moos_gateway", str(self.config_path), *self.extra_args]
-        with open(self.stdout_path, "ab") as out, open(self.stderr_path, "ab") as err:
-            self.proc = subprocess.Popen(cmd, stdout=out, stderr=err, env=self.env, cwd=self.workdir)
+        self.proc.start()
         return self
 
-    def wait(self, timeout: float = 60.0) -> int:
-        assert self.proc is not None
+    def wait(self, timeout: float = 60.0) -> int | None:
         return self.proc.wait(timeout)
 
     def stop(self, sig: int = signal.SIGTERM, timeout: float = 30.0) -> int | None:
         """Send ``sig`` and wait (SIGKILL after ``timeout``); returns the exit code; idempotent."""
-        if self.proc is None:
-            return None
-        if self.proc.poll() is None:
-            self.proc.send_signal(sig)
-            try:
-                self.proc.wait(timeout)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(10)
-        return self.proc.returncode
+        return self.proc.stop(grace=timeout, sig=sig)
 
     def stderr(self) -> str:
-        return self.stderr_path.read_text(errors="replace") if self.stderr_path.exists() else ""
+        return self.proc.stderr_text()
 
     def __enter__(self) -> GatewayProcess:
         return self.start()

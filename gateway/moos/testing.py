@@ -8,32 +8,17 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
-import signal
-import socket
-import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
+from util.process import ChildProcess, free_port, wait_until
+
 from .client import comms
 from .message import MoosMessage
 from .server import MoosDB
-
-
-def free_port() -> int:
-    """A TCP port that was free a moment ago on 127.0.0.1."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def port_open(port: int, host: str = "127.0.0.1") -> bool:
-    """True when something accepts TCP connections on ``host:port`` (a server has finished starting)."""
-    with socket.socket() as s:
-        s.settimeout(0.2)
-        return s.connect_ex((host, port)) == 0
 
 
 def private_netns() -> bool:
@@ -60,51 +45,6 @@ def real_moos_skip_reason(*binaries: str) -> str | None:
     return None
 
 
-def stop_process(proc: subprocess.Popen, timeout: float = 5.0) -> int | None:
-    """SIGTERM ``proc``, then SIGKILL if it has not ended within ``timeout``; returns its exit status."""
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            return proc.wait(timeout)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-    return proc.wait(timeout)
-
-
-@contextlib.contextmanager
-def real_moosdb(workdir: str | os.PathLike[str], port: int | None = None, community: str = "moos",
-                warp: float = 1.0) -> Iterator[tuple[int, subprocess.Popen]]:
-    """The C++ MOOSDB as a child process, listening before this yields ``(port, process)``; stopped on exit.
-
-    Check ``real_moos_skip_reason()`` first: the C++ MOOSDB listens on every address, so only run it inside a
-    private network namespace. Its output goes to ``workdir/MOOSDB-<port>.log``.
-    """
-    port = port or free_port()
-    log_path = Path(workdir) / f"MOOSDB-{port}.log"
-    with open(log_path, "wb") as log:
-        proc = subprocess.Popen(
-            ["MOOSDB", f"--moos_port={port}", f"--moos_community={community}", f"--moos_time_warp={warp}",
-             "--moos_suicide_disable"],
-            stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, cwd=workdir,
-        )
-        try:
-            if not wait_for(lambda: port_open(port) or proc.poll() is not None, 10) or proc.poll() is not None:
-                raise RuntimeError(f"MOOSDB did not start on port {port}: {log_path.read_text()}")
-            yield port, proc
-        finally:
-            stop_process(proc)
-
-
-def wait_for(predicate: Callable[[], Any], timeout: float = 10.0, interval: float = 0.01) -> Any:
-    """Poll ``predicate`` until it returns something truthy (returned) or ``timeout`` passes (returns it falsy)."""
-    deadline = time.monotonic() + timeout
-    while True:
-        result = predicate()
-        if result or time.monotonic() >= deadline:
-            return result
-        time.sleep(interval)
-
-
 @contextlib.contextmanager
 def running_moosdb(community: str = "moos", warp: float = 1.0, **kwargs: Any) -> Iterator[MoosDB]:
     """An in-process :class:`MoosDB` on a free loopback port (``db.port``), stopped on exit."""
@@ -117,61 +57,58 @@ def running_moosdb(community: str = "moos", warp: float = 1.0, **kwargs: Any) ->
 
 
 class MoosDBProcess:
-    """The ``moos-db`` console script as a child process; knows its port and can be restarted on it."""
+    """A MOOSDB as a child process: our ``moos-db`` (``program=None``) or the real one (``program="MOOSDB"``).
+
+    Both take the same flags. Ours picks a free port when ``port`` is 0 and reports it; the real one is given a
+    free port and is ready when it listens. ``restart`` kills it (as a crash would) and starts it on the same port.
+    Its output (all starts) goes to ``log_path``.
+    """
 
     def __init__(self, workdir: str | os.PathLike[str], community: str = "moos", warp: float = 1.0,
-                 port: int = 0, extra_args: Iterable[str] = ()) -> None:
+                 port: int = 0, extra_args: Iterable[str] = (), program: str | None = None) -> None:
         self.workdir = Path(workdir)
         self.community = community
         self.warp = warp
-        self.port = port
+        self.program = program
+        self.port = port or (free_port() if program else 0)
         self.extra_args = list(extra_args)
-        self.proc: subprocess.Popen[bytes] | None = None
-        self._starts = 0
-
-    @property
-    def log_path(self) -> Path:
-        return self.workdir / f"moosdb-{self._starts}.log"
+        self.log_path = self.workdir / f"{program or 'moos-db'}-{self.port or 'any'}.log"
+        self.child: ChildProcess | None = None
 
     def start(self, timeout: float = 20.0) -> MoosDBProcess:
-        """Start (or restart, on the same port) and wait until it listens."""
-        if self.proc is not None and self.proc.poll() is None:
+        """Start (or restart, on the same port) and wait until it listens; ProcessError if it does not."""
+        if self.child is not None and self.child.running:
             return self
-        self._starts += 1
-        out_path = self.workdir / f"moosdb-{self._starts}.out"
-        cmd = [sys.executable, "-m", "gateway.apps.moos_db", f"--moos_port={self.port}",
-               f"--moos_community={self.community}", f"--moos_time_warp={self.warp}", "-v", *self.extra_args]
-        with open(out_path, "wb") as out, open(self.log_path, "wb") as err:
-            self.proc = subprocess.Popen(cmd, stdout=out, stderr=err, cwd=self.workdir)
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            text = out_path.read_text(errors="replace")
-            if " listening on " in text:
-                self.port = int(text.split(" listening on ", 1)[1].split()[0].rsplit(":", 1)[1])
-                return self
-            if self.proc.poll() is not None:
-                raise RuntimeError(f"moos-db exited with {self.proc.returncode}: {self.log_path.read_text()}")
-            time.sleep(0.02)
-        self.stop()
-        raise RuntimeError(f"moos-db did not start within {timeout} s: {self.log_path.read_text()}")
+        program = [self.program, "--moos_suicide_disable"] if self.program else [
+            sys.executable, "-m", "gateway.apps.moos_db", "-v"]
+        args = [*program, f"--moos_port={self.port}", f"--moos_community={self.community}",
+                f"--moos_time_warp={self.warp}", *self.extra_args]
+        if self.child is None:
+            self.child = ChildProcess(args, self.log_path, name=self.program or "moos-db", cwd=self.workdir)
+        self.child.args = args  # a restart keeps the port the first start reported
+        self.child.start()
+        if self.program:
+            self.child.wait_ready(port=self.port, timeout=timeout)
+        else:
+            ready = self.child.wait_ready(r" listening on \S+:(\d+)", timeout=timeout)
+            assert ready is not None
+            self.port = int(ready.group(1))
+        return self
+
+    @property
+    def pid(self) -> int:
+        assert self.child is not None, "not started"
+        return self.child.pid
 
     def kill(self) -> None:
         """SIGKILL, as a crash would; the port is free again once this returns."""
-        if self.proc is not None and self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait(10)
+        if self.child is not None:
+            self.child.kill()
 
     def stop(self) -> None:
         """SIGTERM (then SIGKILL after 5 s); idempotent."""
-        if self.proc is None:
-            return
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-            try:
-                self.proc.wait(5)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(5)
+        if self.child is not None:
+            self.child.stop(grace=5.0)
 
     def restart(self, timeout: float = 20.0) -> MoosDBProcess:
         self.kill()
@@ -186,14 +123,15 @@ class MoosDBProcess:
 
 @contextlib.contextmanager
 def moosdb_process(tmp_path: str | os.PathLike[str], community: str = "moos", warp: float = 1.0,
-                   port: int = 0, extra_args: Iterable[str] = ()) -> Iterator[MoosDBProcess]:
-    """``moos-db`` as a subprocess on a free port (``.port``), logging to ``tmp_path``; stopped on exit."""
-    proc = MoosDBProcess(tmp_path, community, warp, port, extra_args)
-    proc.start()
-    try:
-        yield proc
-    finally:
-        proc.stop()
+                   port: int = 0, extra_args: Iterable[str] = (), program: str | None = None
+                   ) -> Iterator[MoosDBProcess]:
+    """A :class:`MoosDBProcess` (``.port``) logging to ``tmp_path``, stopped on exit.
+
+    ``program="MOOSDB"`` runs the C++ MOOSDB: check ``real_moos_skip_reason()`` first (it listens on every
+    address, so only inside a private network namespace).
+    """
+    with MoosDBProcess(tmp_path, community, warp, port, extra_args, program) as db:
+        yield db
 
 
 @contextlib.contextmanager
@@ -212,7 +150,7 @@ def connected_comms(port: int, name: str, register: Iterable[str] = (), host: st
         if not client.wait_until_connected(timeout * 1000):
             raise TimeoutError(f"{name} did not connect to {host}:{port} within {timeout} s")
         if names:
-            wait_for(lambda: all(client.is_registered_for(n) for n in names), timeout)
+            wait_until(lambda: all(client.is_registered_for(n) for n in names), timeout, f"{name}'s registrations")
             if not client.server_request("VAR_SUMMARY", timeout):
                 raise TimeoutError(f"{name}: the DB did not answer a server request within {timeout} s")
         yield client

@@ -7,7 +7,6 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-import subprocess
 import sys
 import threading
 import time
@@ -15,7 +14,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from gateway.moos import MoosClock, comms
-from gateway.moos.testing import stop_process
+from util.process import ChildProcess
 
 from .kinematic_vehicle import KinematicModel, KinematicVehicle
 
@@ -104,17 +103,12 @@ class Observer:
 
 @contextlib.contextmanager
 def helm_process(mission: Path, tmp_path: Path, command: list[str] | None = None,
-                 env: dict[str, str] | None = None) -> Iterator[subprocess.Popen]:
-    """``ivp-helm MISSION`` (or ``command``) as a child process, with ``env`` added to this process's
-    environment; stopped (SIGTERM, then SIGKILL) on exit."""
-    log = open(tmp_path / "helm.log", "wb")
-    proc = subprocess.Popen(command or [str(IVP_HELM), str(mission), "-v"], stdout=log, stderr=subprocess.STDOUT,
-                            cwd=tmp_path, env={**os.environ, "PYTHONUNBUFFERED": "1", **(env or {})})
-    try:
+                 env: dict[str, str] | None = None) -> Iterator[ChildProcess]:
+    """``ivp-helm MISSION`` (or ``command``) as a child process logging to ``helm.log``, with ``env`` added to this
+    process's environment; stopped (SIGTERM, then SIGKILL) on exit."""
+    with ChildProcess(command or [str(IVP_HELM), str(mission), "-v"], tmp_path / "helm.log", cwd=tmp_path,
+                      env={**os.environ, **(env or {})}) as proc:
         yield proc
-    finally:
-        stop_process(proc, 10)
-        log.close()
 
 
 @contextlib.contextmanager

@@ -14,7 +14,7 @@ from frontseat import groups
 from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.testing import basic_simulator_frontseat_cfg, running_simulator
-from gateway.goby.portal.testing import AppProcess, PortalClient, broker_process
+from gateway.goby.portal.testing import PortalClient, app_process, broker_process
 
 WARP = 10
 ORIGIN = (41.592344, -70.711260)
@@ -58,9 +58,9 @@ def test_triangle_through_the_real_frontseat_path(tmp_path: Path) -> None:
         env = broker.env()
         env["FRONTSEAT_DRIVER_LIBRARY"] = "basic_simulator"
         with PortalClient(broker.interprocess_config(), name="observer") as client, \
-                AppProcess([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(iface_cfg), "-v"], env=env,
+                app_process([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(iface_cfg), "-v"], env=env,
                            log_path=tmp_path / "iface.log"), \
-                AppProcess([sys.executable, "-m", "behaviors.apps.goby_helm_example", str(helm_cfg), "-v"],
+                app_process([sys.executable, "-m", "behaviors.apps.goby_helm_example", str(helm_cfg), "-v"],
                            env=broker.env(), log_path=tmp_path / "helm.log"):
             nav = client.collect(groups.node_status, data_pb.NodeStatus)
             courses = client.collect(groups.desired_course, data_pb.DesiredCourse)

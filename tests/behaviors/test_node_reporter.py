@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
 from behaviors.node_reporter import NodeReporter, NodeReporterConfig
 from gateway.moos import MoosClock
-from gateway.moos.testing import connected_comms, running_moosdb, stop_process, wait_for
+from gateway.moos.testing import connected_comms, running_moosdb
 from translators.node_report_codec import parse_node_report
+from util.process import ChildProcess, wait_until
 
 NODE_REPORTER = Path(sys.executable).parent / "node-reporter"
 
@@ -94,23 +94,18 @@ def test_the_app_reports_a_vehicle_from_its_moosdb(tmp_path):
     with running_moosdb("trail_usv", warp=warp) as db:
         mission = tmp_path / "usv.moos"
         mission.write_text(MISSION.format(port=db.port, warp=warp))
-        log = open(tmp_path / "reporter.log", "wb")
-        proc = subprocess.Popen([str(NODE_REPORTER), str(mission), "-v"], stdout=log, stderr=subprocess.STDOUT)
-        try:
-            with connected_comms(db.port, "uSim", register=["NODE_REPORT_LOCAL", "NODE_REPORT_LOCAL_FIRST"]) as sim:
-                reports: list[str] = []
+        with ChildProcess([str(NODE_REPORTER), str(mission), "-v"], tmp_path / "reporter.log"), \
+                connected_comms(db.port, "uSim", register=["NODE_REPORT_LOCAL", "NODE_REPORT_LOCAL_FIRST"]) as sim:
+            reports: list[str] = []
 
-                def two_reports() -> bool:
-                    for var, value in (("NAV_X", 12.345), ("NAV_Y", -6.0), ("NAV_HEADING", 370.0),
-                                       ("NAV_SPEED", 1.5), ("NAV_DEPTH", 0.0)):
-                        sim.notify(var, value)
-                    reports.extend(m.string() for m in sim.fetch() if m.key() == "NODE_REPORT_LOCAL")
-                    return len(reports) >= 2
+            def two_reports() -> bool:
+                for var, value in (("NAV_X", 12.345), ("NAV_Y", -6.0), ("NAV_HEADING", 370.0),
+                                   ("NAV_SPEED", 1.5), ("NAV_DEPTH", 0.0)):
+                    sim.notify(var, value)
+                reports.extend(m.string() for m in sim.fetch() if m.key() == "NODE_REPORT_LOCAL")
+                return len(reports) >= 2
 
-                assert wait_for(two_reports, timeout=20, interval=0.1), (tmp_path / "reporter.log").read_text()
-        finally:
-            stop_process(proc, 10)
-            log.close()
+            wait_until(two_reports, 20, "two NODE_REPORT_LOCAL")
     fields = parse_node_report(reports[-1])
     assert reports[-1].startswith("NAME=trail_usv,X=12.35,Y=-6,SPD=1.5,HDG=10,DEP=0,TYPE=usv,COLOR=green,")
     assert fields.index >= 1 and fields.length == 4

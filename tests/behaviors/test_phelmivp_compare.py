@@ -16,7 +16,8 @@ from pathlib import Path
 import pytest
 
 from gateway.moos import MoosClock
-from gateway.moos.testing import free_port, real_moos_skip_reason, real_moosdb
+from gateway.moos.testing import moosdb_process, real_moos_skip_reason
+from util.process import free_port
 
 from .moos_harness import REPO, WARP, helm_process, observer, ring_stats, vehicle, write_mission
 from .test_closed_loop import SURVEY, WATCH
@@ -39,7 +40,7 @@ def run_survey(tmp_path: Path, helm: str) -> dict[str, object]:
     port = free_port()
     clock = MoosClock(WARP)
     mission = write_mission(work, port, bhv)
-    with real_moosdb(work, port, community="alpha", warp=WARP), observer(port, clock, WATCH + ["DEPLOY"]) as obs, \
+    with moosdb_process(work, port=port, program="MOOSDB", community="alpha", warp=WARP), observer(port, clock, WATCH + ["DEPLOY"]) as obs, \
             helm_process(mission, work, HELMS[helm](mission) if HELMS[helm] else None), \
             vehicle(port, clock, x=0, y=0, heading=0):
         assert obs.wait(lambda: obs.last("IVPHELM_STATE") == "PARK", timeout=30), helm
@@ -60,7 +61,7 @@ def run_loiter(tmp_path: Path, helm: str) -> dict[str, float]:
     port = free_port()
     clock = MoosClock(WARP)
     mission = write_mission(work, port, REPO / "behaviors" / "usv.bhv", community="trail_usv")
-    with real_moosdb(work, port, community="alpha", warp=WARP), observer(port, clock, WATCH) as obs, \
+    with moosdb_process(work, port=port, program="MOOSDB", community="alpha", warp=WARP), observer(port, clock, WATCH) as obs, \
             helm_process(mission, work, HELMS[helm](mission) if HELMS[helm] else None), \
             vehicle(port, clock, x=0, y=-120, heading=0) as sim:
         assert obs.wait(lambda: obs.last("IVPHELM_STATE") == "DRIVE", timeout=30), helm

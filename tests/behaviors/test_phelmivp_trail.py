@@ -9,7 +9,6 @@ on a straight line east at 1.5 m/s, reported in the course's format every 20 s.
 from __future__ import annotations
 
 import math
-import subprocess
 import sys
 import threading
 from pathlib import Path
@@ -17,9 +16,10 @@ from pathlib import Path
 import pytest
 
 from gateway.moos import MoosClock
-from gateway.moos.testing import free_port, real_moos_skip_reason, real_moosdb, stop_process
+from gateway.moos.testing import moosdb_process, real_moos_skip_reason
 from launch.config import render
 from translators.node_report_codec import NodeReport, format_course_report, parse_node_report
+from util.process import ChildProcess, free_port
 
 from .moos_harness import REPO, helm_process, observer, vehicle
 from .test_trail_closed_loop import STATION, auv_mission, trail_errors
@@ -73,7 +73,7 @@ def run_trail(tmp_path: Path, helm: str) -> dict[str, object]:
     port = free_port()
     clock = MoosClock(WARP)
     mission = auv_mission(work, port, "AUV0", bhv, auv=True, warp=WARP)
-    with real_moosdb(work, port, community="AUV0", warp=WARP), \
+    with moosdb_process(work, port=port, program="MOOSDB", community="AUV0", warp=WARP), \
             observer(port, clock, ["IVPHELM_STATE", "IVPHELM_ALLSTOP", "REGION", "BHV_ERROR"]) as obs, \
             helm_process(mission, work, HELMS[helm](mission) if HELMS[helm] else None), \
             vehicle(port, clock, x=USV_X0, y=USV_Y - 10, heading=90) as sim:
@@ -147,22 +147,18 @@ def test_node_reporter_writes_what_pnodereporter_writes(tmp_path: Path) -> None:
     mission.write_text(REPORTER_MOOS.format(port=port))
     clock = MoosClock(1.0)
     ours_cmd = [str(Path(sys.executable).parent / "node-reporter"), str(mission), "--alias", "pNodeReporterPy"]
-    with real_moosdb(tmp_path, port, community="auv0"), \
-            observer(port, clock, ["NODE_REPORT_LOCAL", "NODE_REPORT_PY"]) as obs:
-        procs = [subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-                 for cmd in (["pNodeReporter", str(mission)], ours_cmd)]
-        try:
-            def both() -> bool:
-                for var, value in (("NAV_X", -12.345), ("NAV_Y", 6.7), ("NAV_SPEED", 1.25), ("NAV_HEADING", 370.5),
-                                   ("NAV_DEPTH", 12.0), ("NAV_LAT", 43.82494863), ("NAV_LONG", -70.32964602),
-                                   ("IVPHELM_STATE", "DRIVE"), ("IVPHELM_ALLSTOP", "clear")):
-                    obs.post(var, value)
-                return len(obs.values("NODE_REPORT_LOCAL")) > 3 and len(obs.values("NODE_REPORT_PY")) > 3
+    with moosdb_process(tmp_path, port=port, program="MOOSDB", community="auv0"), \
+            observer(port, clock, ["NODE_REPORT_LOCAL", "NODE_REPORT_PY"]) as obs, \
+            ChildProcess(["pNodeReporter", str(mission)], tmp_path / "pNodeReporter.log", cwd=tmp_path), \
+            ChildProcess(ours_cmd, tmp_path / "node-reporter.log", cwd=tmp_path):
+        def both() -> bool:
+            for var, value in (("NAV_X", -12.345), ("NAV_Y", 6.7), ("NAV_SPEED", 1.25), ("NAV_HEADING", 370.5),
+                               ("NAV_DEPTH", 12.0), ("NAV_LAT", 43.82494863), ("NAV_LONG", -70.32964602),
+                               ("IVPHELM_STATE", "DRIVE"), ("IVPHELM_ALLSTOP", "clear")):
+                obs.post(var, value)
+            return len(obs.values("NODE_REPORT_LOCAL")) > 3 and len(obs.values("NODE_REPORT_PY")) > 3
 
-            assert obs.wait(both, timeout=30)
-        finally:
-            for proc in procs:
-                stop_process(proc, 10)
+        assert obs.wait(both, timeout=30)
     real, ours = str(obs.values("NODE_REPORT_LOCAL")[-1]), str(obs.values("NODE_REPORT_PY")[-1])
     print(f"\npNodeReporter: {real}\nnode-reporter: {ours}")
 

@@ -15,8 +15,8 @@ from frontseat.protobuf import basic_simulator_tuning_pb2 as tuning_pb
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.simulator.server import SimulatorServer
-from frontseat.testing import wait_until
 from util.geodesy import UTMGeodesy
+from util.process import wait_until
 
 ORIGIN = (41.592344, -70.711260)
 

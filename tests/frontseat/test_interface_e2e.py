@@ -16,8 +16,9 @@ import pytest
 from frontseat import groups
 from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_pb2 as fs
-from frontseat.testing import SimulatorProcess, basic_simulator_frontseat_cfg, free_tcp_port, start_simulator
-from gateway.goby.portal.testing import AppProcess, PortalClient, broker_process
+from frontseat.testing import SimulatorProcess, basic_simulator_frontseat_cfg, start_simulator
+from gateway.goby.portal.testing import PortalClient, app_process, broker_process
+from util.process import ChildProcess, free_port
 
 WARP = 10
 HELM_TIMEOUT = 60.0  # simulated seconds: 6 s real at warp 10 (counted from start: room for a slow start)
@@ -35,10 +36,10 @@ def write_config(path: Path, port: int, **frontseat: object) -> Path:
     return path
 
 
-def start_interface(tmp_path: Path, broker, cfg: Path, name: str = "iface") -> AppProcess:
+def start_interface(tmp_path: Path, broker, cfg: Path, name: str = "iface") -> ChildProcess:
     env = broker.env()
     env["FRONTSEAT_DRIVER_LIBRARY"] = "basic_simulator"
-    return AppProcess(
+    return app_process(
         [sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg), "-vv"],
         env=env,
         log_path=tmp_path / f"{name}.log",
@@ -96,7 +97,7 @@ class ScriptedHelm:
 
 
 def test_standby_listen_command_helm_error_fs_error_and_recovery(tmp_path: Path) -> None:
-    port = free_tcp_port()
+    port = free_port()
     sims: list[SimulatorProcess] = []
     with broker_process(tmp_path, platform="usv") as broker:
         cfg = write_config(
@@ -199,7 +200,7 @@ def test_standby_listen_command_helm_error_fs_error_and_recovery(tmp_path: Path)
 
 def test_exit_on_error_quits_with_code_zero(tmp_path: Path) -> None:
     with broker_process(tmp_path, platform="usv") as broker:
-        cfg = write_config(tmp_path / "fs.pb.cfg", free_tcp_port(), helm_running_timeout=2,
+        cfg = write_config(tmp_path / "fs.pb.cfg", free_port(), helm_running_timeout=2,
                            frontseat_connected_timeout=2)
         cfg.write_text(cfg.read_text().replace("frontseat_cfg {", "frontseat_cfg {\n  exit_on_error: true"))
         iface = start_interface(tmp_path, broker, cfg)
@@ -264,7 +265,7 @@ def test_a_driver_factory_that_raises_exits_1_promptly(tmp_path: Path) -> None:
         cfg.write_text("frontseat_cfg { require_helm: false }\n")  # this driver has no config extension
         env = broker.env()
         env["FRONTSEAT_DRIVER_LIBRARY"] = str(driver)
-        iface = AppProcess([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg)], env=env,
+        iface = app_process([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg)], env=env,
                            log_path=tmp_path / "iface.log")
         try:
             code = iface.wait(60)

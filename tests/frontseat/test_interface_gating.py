@@ -14,8 +14,8 @@ from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_interface_config_pb2 as app_pb
 from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.protobuf import navigation_pb2 as nav_pb
-from frontseat.testing import wait_until
 from gateway.goby.portal.testing import PortalClient, broker_process, running_app
+from util.process import wait_until
 
 STATUS_PERIOD = 5
 HELM_TIMEOUT = 30.0

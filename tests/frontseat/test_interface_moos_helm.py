@@ -13,7 +13,7 @@ from pathlib import Path
 from frontseat import groups
 from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.testing import basic_simulator_frontseat_cfg, running_simulator
-from gateway.goby.portal.testing import AppProcess, PortalClient, broker_process
+from gateway.goby.portal.testing import PortalClient, app_process, broker_process
 from gateway.moos.testing import connected_comms, running_moosdb
 
 WARP = 10
@@ -34,7 +34,7 @@ def test_moos_helm_drives_the_simulator_through_the_interface(tmp_path: Path) ->
         )
         env = broker.env()
         env["FRONTSEAT_DRIVER_LIBRARY"] = "basic_simulator"
-        iface = AppProcess([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg), "-v"], env=env,
+        iface = app_process([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg), "-v"], env=env,
                            log_path=tmp_path / "iface.log")
         try:
             with (

@@ -12,8 +12,9 @@ from frontseat.errors import SimulatorLineError
 from frontseat.simulator import protocol
 from frontseat.simulator.model import Simulation
 from frontseat.simulator.server import SimulatorServer
-from frontseat.testing import SimClient, running_simulator, wait_until
+from frontseat.testing import SimClient, running_simulator
 from util.geodesy import UTMGeodesy
+from util.process import wait_until
 
 LAT, LON = 41.592344, -70.71126
 

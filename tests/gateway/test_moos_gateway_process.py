@@ -12,10 +12,9 @@ import time
 
 import pytest
 from gateway_plugin_sources import ECHO_PLUGIN
-from moosdb_kinds import any_moosdb, real_moosdb_skip_reason
 
 from gateway.goby.portal.testing import PortalClient, broker_process
-from gateway.moos.testing import collect_mail, connected_comms, moosdb_process
+from gateway.moos.testing import collect_mail, connected_comms, moosdb_process, real_moos_skip_reason
 from translators.moos_interface import TIME_VAR
 from translators.testing import GatewayProcess
 
@@ -36,7 +35,7 @@ def _moos_to_goby(poster, peer: PortalClient, got: list[str], tag: str, buffered
 
 
 REAL = pytest.param("real", signal.SIGTERM, id="real-MOOSDB-SIGTERM", marks=[
-    pytest.mark.interop, pytest.mark.skipif(real_moosdb_skip_reason() is not None, reason=str(real_moosdb_skip_reason()))])
+    pytest.mark.interop, pytest.mark.skipif(real_moos_skip_reason() is not None, reason=str(real_moos_skip_reason()))])
 
 
 @pytest.mark.parametrize(("moosdb_kind", "stop_signal"), [pytest.param("ours", signal.SIGTERM, id="ours-SIGTERM-restart"),
@@ -44,7 +43,7 @@ REAL = pytest.param("real", signal.SIGTERM, id="real-MOOSDB-SIGTERM", marks=[
 def test_gateway_process_end_to_end(tmp_path, moosdb_kind, stop_signal):
     plugin = tmp_path / "echo_plugin.py"
     plugin.write_text(ECHO_PLUGIN)
-    with any_moosdb(moosdb_kind, tmp_path) as db, broker_process(tmp_path, platform="gwe2e") as broker:
+    with moosdb_process(tmp_path, program=None if moosdb_kind == "ours" else "MOOSDB") as db, broker_process(tmp_path, platform="gwe2e") as broker:
         gateway = GatewayProcess(tmp_path, [str(plugin)], _gateway_config(broker, db.port), extra_args=["-v"])
         with gateway, PortalClient(broker.interprocess_config(), name="peer") as peer, \
                 connected_comms(db.port, "poster", register=["OUT", "OUT_LOWER", TIME_VAR, "DB_CLIENTS"]) as poster:

@@ -14,13 +14,12 @@ from pathlib import Path
 
 import pytest
 
-from frontseat.testing import wait_until
 from gateway.goby.acomms.udp_multicast import random_multicast
-from launch.config import free_tcp_port
 from launch.liaison.testing import browser_skip_reason, chromium
 from launch.usv.analysis import command_effects
 from launch.usv.mission import UsvMission
 from launch.usv.settings import UsvSettings
+from util.process import free_port, wait_until
 
 SKIP = browser_skip_reason()
 pytestmark = pytest.mark.skipif(SKIP is not None, reason=str(SKIP))
@@ -34,8 +33,8 @@ PREFIX = "goby::middleware::frontseat::"
 def mission(tmp_path_factory):
     run_dir = tmp_path_factory.mktemp("liaison_usv")
     socket_dir = Path(tempfile.mkdtemp(prefix="usvl-", dir="/tmp"))
-    settings = UsvSettings(run_dir=run_dir, warp=20, moos_port=free_tcp_port(), sim_port=free_tcp_port(),
-                           liaison_port=free_tcp_port(), schedule="none", socket_name=str(socket_dir / "goby_usv"),
+    settings = UsvSettings(run_dir=run_dir, warp=20, moos_port=free_port(), sim_port=free_port(),
+                           liaison_port=free_port(), schedule="none", socket_name=str(socket_dir / "goby_usv"),
                            sat_port=random_multicast()[1])
     lines: list[str] = []
     usv = UsvMission(settings, report=lines.append)

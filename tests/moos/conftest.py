@@ -12,11 +12,7 @@ from pathlib import Path
 import pytest
 
 from gateway.moos.server import MoosDB
-from gateway.moos.testing import real_moos_skip_reason, real_moosdb
-
-
-def real_moosdb_skip_reason() -> str | None:
-    return real_moos_skip_reason("MOOSDB")
+from gateway.moos.testing import moosdb_process, real_moos_skip_reason
 
 
 @pytest.fixture
@@ -32,9 +28,9 @@ def db_port(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[int]:
         with MoosDB(community="moos") as db:
             yield db.port
     else:
-        reason = real_moosdb_skip_reason()
+        reason = real_moos_skip_reason()
         if reason:
             pytest.skip(reason)
-        with real_moosdb(tmp_path) as (port, _):
-            yield port
+        with moosdb_process(tmp_path, program="MOOSDB") as db:
+            yield db.port
 

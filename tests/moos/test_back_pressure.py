@@ -8,7 +8,7 @@ import threading
 from gateway.moos import comms
 from gateway.moos.codec import PROTOCOL_STRING_SIZE, PacketReader, encode_packet
 from gateway.moos.message import DOUBLE, NOTIFY, WELCOME, MoosMessage
-from gateway.moos.testing import wait_for
+from util.process import wait_until
 
 
 class StallingDBDouble:
@@ -80,7 +80,7 @@ def test_notify_blocks_when_the_link_is_full_and_loses_nothing() -> None:
         db.resume()
         assert done.wait(30)
         publisher.join(10)
-        assert wait_for(lambda: len(db.received) >= count, 30)
+        wait_until(lambda: len(db.received) >= count, 30, "len(db.received) >= count")
         assert [int(m.string().split(":", 1)[0]) for m in db.received] == list(range(count))
     finally:
         client.close(False)

@@ -10,7 +10,8 @@ import pytest
 from gateway.moos import MoosMessage, comms
 from gateway.moos.clock import MoosClock
 from gateway.moos.errors import PoisonedError
-from gateway.moos.testing import collect_mail, connected_comms, wait_for
+from gateway.moos.testing import collect_mail, connected_comms
+from util.process import wait_until
 
 
 def values(msgs: list[MoosMessage]) -> list[object]:
@@ -63,7 +64,8 @@ def test_many_messages_arrive_once_and_in_order(db_port: int) -> None:
 def test_registering_delivers_the_current_value(db_port: int) -> None:
     with connected_comms(db_port, "pub") as pub, connected_comms(db_port, "sub") as sub:
         pub.notify("EXISTING", "was here", 42.0)
-        assert wait_for(lambda: pub.notify("FLUSH", 1.0) and False, 0.2) is False
+        pub.notify("FLUSH", 1.0)
+        time.sleep(0.2)  # let EXISTING reach the DB before sub registers
         sub.register("EXISTING", 0)
         (msg,) = collect_mail(sub, ["EXISTING"])
         assert msg.string() == "was here" and msg.source() == "pub" and msg.time() == 42.0
@@ -91,7 +93,7 @@ def test_unregister_stops_delivery(db_port: int) -> None:
         assert values(collect_mail(sub, ["U_VAR"])) == [1.0]
         assert sub.unregister("U_VAR")
         assert not sub.is_registered_for("U_VAR")
-        wait_for(lambda: False, 0.2)  # let the U reach the DB before the next write
+        time.sleep(0.2)  # let the U reach the DB before the next write
         pub.notify("U_VAR", 2.0)
         pub.notify("U_MARK", 1.0)
         got = collect_mail(sub, ["U_VAR", "U_MARK"], until=lambda ms: any(m.key() == "U_MARK" for m in ms))
@@ -102,14 +104,14 @@ def test_wildcard_register_and_unregister_quirk(db_port: int) -> None:
     with connected_comms(db_port, "wpub") as pub, connected_comms(db_port, "wsub") as sub:
         pub.notify("W_A", 1.0)
         pub.notify("V_OTHER", 1.0)
-        wait_for(lambda: False, 0.2)
+        time.sleep(0.2)
         assert sub.register("W_*", "*", 0)
         got = collect_mail(sub, ["W_A", "V_OTHER"], until=1)
         assert [m.key() for m in got] == ["W_A"]
         pub.notify("W_B", 2.0)  # a new variable: the stored filter matches on its first write
         assert [m.key() for m in collect_mail(sub, ["W_B"])] == ["W_B"]
         assert sub.unregister("W_*", "*")
-        wait_for(lambda: False, 0.2)
+        time.sleep(0.2)
         pub.notify("W_A", 3.0)
         pub.notify("W_NEW", 4.0)  # quirk kept from MOOSDB: the filter survives the wildcard unregister
         got = collect_mail(sub, ["W_A", "W_NEW"], until=lambda ms: any(m.key() == "W_NEW" for m in ms))
@@ -120,11 +122,11 @@ def test_wildcard_app_pattern_filters_by_writer(db_port: int) -> None:
     with connected_comms(db_port, "pNav") as nav, connected_comms(db_port, "pOther") as other, \
             connected_comms(db_port, "app_sub") as sub:
         sub.register("*", "pNav", 0)
-        wait_for(lambda: False, 0.2)
+        time.sleep(0.2)
         other.notify("AP_OTHER", 1.0)
         nav.notify("AP_NAV_X", 2.0)
         got = collect_mail(sub, ["AP_OTHER", "AP_NAV_X"], until=1)
-        wait_for(lambda: False, 0.2)
+        time.sleep(0.2)
         got += collect_mail(sub, ["AP_OTHER"], until=lambda _: True, timeout=0.1)
         assert [m.key() for m in got] == ["AP_NAV_X"]
 
@@ -135,7 +137,7 @@ def test_type_is_locked_by_the_first_write(db_port: int) -> None:
         pub.notify("TYPED", "a string is refused")
         pub.notify("TYPED", 2.0)
         got = collect_mail(sub, ["TYPED"], until=2)
-        wait_for(lambda: False, 0.2)
+        time.sleep(0.2)
         got += collect_mail(sub, ["TYPED"], until=lambda _: True, timeout=0.05)
         assert values(got) == [1.0, 2.0]
 
@@ -152,7 +154,7 @@ def test_duplicate_name_is_poisoned(db_port: int) -> None:
         second = comms()
         try:
             second.run("127.0.0.1", db_port, "twin")
-            assert wait_for(lambda: second.get_fatal_error() is not None, 10)
+            wait_until(lambda: second.get_fatal_error() is not None, 10, "second.get_fatal_error() is not None")
             assert isinstance(second.get_fatal_error(), PoisonedError)
             assert "already exists" in str(second.get_fatal_error())
             assert not second.is_connected()
@@ -226,7 +228,7 @@ def test_synchronous_client_exchanges_mail(db_port: int) -> None:
 def test_server_requests(db_port: int) -> None:
     with connected_comms(db_port, "qpub") as pub, connected_comms(db_port, "q") as q:
         pub.notify("REQ_VAR", 11.0)
-        wait_for(lambda: False, 0.2)
+        time.sleep(0.2)
         summary = q.server_request("VAR_SUMMARY")
         assert len(summary) == 1 and "REQ_VAR" in summary[0].string().split(",")
         everything = {m.key(): m for m in q.server_request("ALL")}
@@ -337,7 +339,7 @@ def test_skew_is_learned_from_the_welcome_and_kept_by_timing_replies() -> None:
             assert client.wait_until_connected(10_000)
             assert clock.skew == pytest.approx(100.0, abs=0.5)  # from the WELCOME
             welcome_skew = clock.skew
-            assert wait_for(lambda: clock.skew != welcome_skew, 5)  # timing replies blend in new measurements
+            wait_until(lambda: clock.skew != welcome_skew, 5, "a new skew")  # timing replies blend in new measurements
             assert clock.skew == pytest.approx(100.0, abs=0.5)
             client.notify("SKEWED", 1.0)
             (msg,) = collect_mail(client, ["SKEWED"])
@@ -358,7 +360,7 @@ def test_response_option_slows_a_client_down() -> None:
     def arrival_spread(db_port: int, name: str) -> float:
         with connected_comms(db_port, "watch_" + name, [name + "_V"]) as watcher, \
                 connected_comms(db_port, name) as writer:
-            wait_for(lambda: False, 1.3)  # a timing round trip tells the writer its delay
+            time.sleep(1.3)  # a timing round trip tells the writer its delay
 
             def write_spaced() -> None:
                 for i in range(5):

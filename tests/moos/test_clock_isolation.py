@@ -16,7 +16,8 @@ import pytest
 import gateway.moos as moos
 from gateway.moos import MoosClock, choose_client, comms
 from gateway.moos.clock import DEFAULT_CLOCK
-from gateway.moos.testing import collect_mail, connected_comms, running_moosdb, wait_for
+from gateway.moos.testing import collect_mail, connected_comms, running_moosdb
+from util.process import wait_until
 
 
 @pytest.fixture
@@ -92,7 +93,7 @@ def test_clients_with_their_own_clocks_do_not_interfere(our_db, quiet_clients):
     fast, plain, default = quiet_clients
     assert fast.clock is not plain.clock and default.clock is DEFAULT_CLOCK
     # each client learned its own skew: the warp-10 one about -9 x unix time, so both tell the DB's time
-    assert wait_for(lambda: fast.clock.skew < -8 * time.time())
+    wait_until(lambda: fast.clock.skew < -8 * time.time(), 10, "fast.clock.skew < -8 * time.time()")
     assert abs(plain.clock.skew) < 1.0
     for client in (fast, plain, default):
         assert client.clock.time() == pytest.approx(our_db.clock.time(), abs=1.0)
@@ -120,7 +121,7 @@ def test_clients_on_dbs_with_different_warps_keep_separate_skews():
                 client.set_quiet(True)
                 client.run("127.0.0.1", db.port, "skewed")
                 assert client.wait_until_connected(10_000)
-            assert wait_for(lambda: fast.clock.skew > 18 * time.time())
+            wait_until(lambda: fast.clock.skew > 18 * time.time(), 10, "fast.clock.skew > 18 * time.time()")
             assert slow.clock.time() == pytest.approx(slow_db.clock.time(), abs=1.0)
             assert fast.clock.time() == pytest.approx(fast_db.clock.time(), abs=20.0)
             assert abs(slow.clock.skew) < 1.0

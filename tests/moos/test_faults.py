@@ -15,7 +15,8 @@ from hypothesis import strategies as st
 from gateway.moos.codec import PROTOCOL_BYTES, PacketReader, encode_packet
 from gateway.moos.message import DATA, DOUBLE, NOTIFY, REGISTER, STRING, TIMING, MoosMessage
 from gateway.moos.server import MoosDB
-from gateway.moos.testing import collect_mail, connected_comms, running_moosdb, wait_for
+from gateway.moos.testing import collect_mail, connected_comms, running_moosdb
+from util.process import wait_until
 
 
 def hello_bytes(name: str, asynchronous: bool = True) -> bytes:
@@ -110,7 +111,7 @@ def test_garbage_after_handshake_drops_only_that_client(garbage: bytes, reason: 
             read_until_closed(sock)
         exchange(alice, bob, 20, 20)
         check_sequences(alice, bob, 40)
-        assert wait_for(lambda: reason in reasons(db), 5), reasons(db)
+        wait_until(lambda: reason in reasons(db), 5, "reason in reasons(db)")
         assert "'vandal'" in db.dropped[0][0]
         assert "vandal" not in db.client_names()
 
@@ -151,7 +152,7 @@ def test_slow_reader_is_dropped_with_a_reason_and_others_lose_nothing() -> None:
         lazy.sendall(hello_bytes("lazy"))
         lazy.sendall(encode_packet([MoosMessage(REGISTER, DOUBLE, 0, src=b"lazy", key=b"BIG", dval=0.0)]))
         with connected_comms(db.port, "eager", ["BIG"]) as eager, connected_comms(db.port, "pub") as pub:
-            assert wait_for(lambda: "lazy" in db.client_names(), 5)
+            wait_until(lambda: "lazy" in db.client_names(), 5, "'lazy' in db.client_names()")
             for i in range(n):
                 assert pub.notify("BIG", f"{i}:{payload}")
                 if i % 500 == 0:  # keep the lazy client's connection alive (until it is dropped); it never reads
@@ -159,7 +160,7 @@ def test_slow_reader_is_dropped_with_a_reason_and_others_lose_nothing() -> None:
                         lazy.sendall(encode_packet([MoosMessage(TIMING, DOUBLE, key=b"_async_timing", msg_time=1.0)]))
             got = collect_mail(eager, ["BIG"], until=n, timeout=60)
             assert [int(m.string().split(":", 1)[0]) for m in got] == list(range(n))
-        assert wait_for(lambda: "not keeping up" in reasons(db), 10), reasons(db)
+        wait_until(lambda: "not keeping up" in reasons(db), 10, "'not keeping up' in reasons(db)")
 
 
 # ---- property: random and mutated packets from several connections -------------------------------------

@@ -19,7 +19,8 @@ import pytest
 from gateway.moos import choose_client
 from gateway.moos.errors import MoosError
 from gateway.moos.factory import pymoos_available
-from gateway.moos.testing import collect_mail, connected_comms, stop_process
+from gateway.moos.testing import collect_mail, connected_comms
+from util.process import ChildProcess
 
 pytestmark = pytest.mark.interop
 SCRIPT = Path(__file__).with_name("pymoos_script.py")
@@ -104,24 +105,19 @@ def test_uxms_scopes_our_db(db_port: int, tmp_path: Path) -> None:
     uxms = _tool_or_skip("uXMS")
     with connected_comms(db_port, "poster") as poster:
         poster.notify("SCOPED_VAR", "visible-value")
-        out = tmp_path / "uxms.out"
-        with open(out, "wb") as sink:
-            proc = subprocess.Popen([uxms, "SCOPED_VAR", "--serverhost=127.0.0.1", f"--serverport={db_port}",
-                                     "--mode=streaming", "--show=source"], stdout=sink, stderr=subprocess.STDOUT)
-            try:
-                deadline = time.monotonic() + 15
-                while time.monotonic() < deadline and b"visible-value" not in out.read_bytes():
-                    poster.notify("KEEP_BUSY", 1.0)  # the C++ DB pushes held mail after notifications
-                    time.sleep(0.1)
-            finally:
-                stop_process(proc)
-        text = out.read_bytes().decode(errors="replace")
+        with ChildProcess([uxms, "SCOPED_VAR", "--serverhost=127.0.0.1", f"--serverport={db_port}",
+                           "--mode=streaming", "--show=source"], tmp_path / "uxms.out") as proc:
+            deadline = time.monotonic() + 15
+            while time.monotonic() < deadline and "visible-value" not in proc.output():
+                poster.notify("KEEP_BUSY", 1.0)  # the C++ DB pushes held mail after notifications
+                time.sleep(0.1)
+            text = proc.output()
         assert "visible-value" in text and "poster" in text
 
 
 def test_a_real_moos_app_runs_against_our_db(tmp_path: Path) -> None:
     """uTimerScript (a C++ CMOOSApp: async comms, mission file, app tick) publishes through our DB."""
-    script = _tool_or_skip("uTimerScript")
+    _tool_or_skip("uTimerScript")
     from gateway.moos.testing import running_moosdb
 
     with running_moosdb(community="tsx") as db, connected_comms(db.port, "watch_ts", ["TS_HELLO", "TS_NUM"]) as w:
@@ -132,12 +128,8 @@ def test_a_real_moos_app_runs_against_our_db(tmp_path: Path) -> None:
             '  event = var=TS_HELLO, val="world", time=0.2\n  event = var=TS_NUM, val=42, time=0.4\n}\n'
         )
         # argv[0] must be the bare name: a MOOSApp looks up "ProcessConfig = <argv[0]>"
-        proc = subprocess.Popen(["uTimerScript", str(mission)], executable=script, stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL, cwd=tmp_path)
-        try:
+        with ChildProcess(["uTimerScript", str(mission)], tmp_path / "uTimerScript.log", cwd=tmp_path):
             got = {m.key(): m for m in collect_mail(w, ["TS_HELLO", "TS_NUM"], timeout=20)}
-        finally:
-            stop_process(proc)
         assert got["TS_HELLO"].string() == "world" and got["TS_HELLO"].source() == "uTimerScript"
         assert got["TS_NUM"].is_double() and got["TS_NUM"].double() == 42.0
         assert got["TS_NUM"].community() == "tsx"

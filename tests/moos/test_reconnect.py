@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import threading
+import time
 from pathlib import Path
 
 from gateway.moos import comms
-from gateway.moos.testing import collect_mail, connected_comms, moosdb_process, running_moosdb, wait_for
+from gateway.moos.testing import collect_mail, connected_comms, moosdb_process, running_moosdb
+from util.process import wait_until
 
 
 def test_clients_reconnect_and_reregister_after_a_db_crash(tmp_path: Path) -> None:
@@ -22,14 +24,14 @@ def test_clients_reconnect_and_reregister_after_a_db_crash(tmp_path: Path) -> No
         try:
             with connected_comms(db.port, "writer") as pub:
                 assert sub.wait_until_connected(10_000)
-                assert wait_for(lambda: sub.is_registered_for("AFTER_CRASH"), 5)
+                wait_until(lambda: sub.is_registered_for("AFTER_CRASH"), 5, "sub.is_registered_for('AFTER_CRASH')")
                 pub.notify("AFTER_CRASH", 1.0)
                 assert [m.double() for m in collect_mail(sub, ["AFTER_CRASH"])] == [1.0]
 
                 db.restart()  # SIGKILL, then a new moos-db on the same port
                 assert disconnected.wait(10)
-                assert wait_for(lambda: len(connects) >= 2 and sub.is_connected() and pub.is_connected(), 20)
-                wait_for(lambda: False, 0.3)  # let the re-registration reach the new DB
+                wait_until(lambda: len(connects) >= 2 and sub.is_connected() and pub.is_connected(), 20, "len(connects) >= 2 and sub.is_connected() and p...")
+                time.sleep(0.3)  # let the re-registration reach the new DB
                 pub.notify("AFTER_CRASH", 2.0)
                 pub.notify("W_NEW", 3.0)
                 got = collect_mail(sub, ["AFTER_CRASH", "W_NEW"])
@@ -48,7 +50,7 @@ def test_on_connect_registration_is_not_doubled_by_the_automatic_one() -> None:
         sub.run("127.0.0.1", db.port, "reader")
         try:
             got = collect_mail(sub, ["ONCE"])
-            wait_for(lambda: False, 0.3)
+            time.sleep(0.3)
             got += collect_mail(sub, ["ONCE"], until=lambda _: True, timeout=0.05)
             assert [m.double() for m in got] == [1.0]
             assert sub.register("ONCE", 0.5)  # a new interval is sent as usual

@@ -12,7 +12,8 @@ import pytest
 from gateway.apps import moos_poke as poke
 from gateway.apps import moos_scope as scope
 from gateway.apps.moos_tool_args import adopt_db_time_warp
-from gateway.moos.testing import MoosDBProcess, collect_mail, connected_comms, free_port, running_moosdb
+from gateway.moos.testing import MoosDBProcess, collect_mail, connected_comms, running_moosdb
+from util.process import free_port
 
 BIN = Path(sys.executable).parent
 

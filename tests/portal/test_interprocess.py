@@ -12,21 +12,22 @@ import pytest
 from gateway.goby.dccl import Codec as DcclCodec
 from gateway.goby.portal import Scheme
 from gateway.goby.portal.marshalling import parse_dynamic
-from gateway.goby.portal.testing import AppProcess, BrokerProcess, PortalClient, broker_process
+from gateway.goby.portal.testing import BrokerProcess, PortalClient, app_process, broker_process
 from tests.protobuf.sample_messages_pb2 import DCCLSample, Sample, Widget
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
+from util.process import ChildProcess
 
 REPO = Path(__file__).resolve().parents[2]
 
 
-def sample_app(broker: BrokerProcess, tmp_path: Path, role: str, *args: str, name: str | None = None) -> AppProcess:
+def sample_app(broker: BrokerProcess, tmp_path: Path, role: str, *args: str, name: str | None = None) -> ChildProcess:
     name = name or f"sample_{role}"
     cmd = [sys.executable, "-m", "tests.portal.apps.sample_app", f"--role={role}", "-a", name, "-v", *args]
-    return AppProcess(cmd, env=broker.env(), cwd=REPO, log_path=tmp_path / f"{name}.log")
+    return app_process(cmd, env=broker.env(), cwd=REPO, log_path=tmp_path / f"{name}.log")
 
 
-def received(app: AppProcess, group: str) -> list[int]:
-    return [int(line.split()[2]) for line in app.lines if line.startswith(f"RX {group} ")]
+def received(app: ChildProcess, group: str) -> list[int]:
+    return [int(line.split()[2]) for line in app.lines() if line.startswith(f"RX {group} ")]
 
 
 def test_two_apps_exchange_protobuf_on_several_groups(broker: BrokerProcess, tmp_path: Path) -> None:
@@ -34,9 +35,9 @@ def test_two_apps_exchange_protobuf_on_several_groups(broker: BrokerProcess, tmp
     group_args = [arg for g in groups for arg in ("--group", g)]
     # the hold makes the exchange lossless: tx publishes only after rx has subscribed and reported ready
     with sample_app(broker, tmp_path, "rx", *group_args, "--count", "20") as rx:
-        assert rx.wait_for("RX DONE", 0.5) is None
+        assert rx.wait_for_output("RX DONE", 0.5) is None
         with sample_app(broker, tmp_path, "tx", *group_args, "--count", "20", "--publish_period", "0.01") as tx:
-            assert rx.wait_for("RX DONE", 60), rx.stderr_text()
+            assert rx.wait_for_output("RX DONE", 60), rx.stderr_text()
             assert tx.wait(30) == 0, tx.stderr_text()
         assert rx.wait(30) == 0
     for group in groups:
@@ -53,7 +54,7 @@ def test_hold_buffers_publications_until_required_clients_are_ready(tmp_path: Pa
         assert tx.portal.hold_state() is True
         with sample_app(broker, tmp_path, "rx", "--group", "held", "--count", "5", name="hold_rx") as rx:
             assert tx.poll_until(lambda: not tx.portal.hold_state(), 30)
-            assert rx.wait_for("RX DONE", 30), rx.stderr_text()
+            assert rx.wait_for_output("RX DONE", 30), rx.stderr_text()
         assert received(rx, "held") == [1, 2, 3, 4, 5]
 
 
@@ -156,11 +157,11 @@ def test_multithread_app_thread_gets_callbacks_and_relays_on_interthread(
             nonlocal a
             a += 1
             tx.publish("mt", Sample(a=a))
-            return app.wait_for("RX relay", 0.1) is not None
+            return app.wait_for_output("RX relay", 0.1) is not None
 
         assert tx.poll_until(relayed, 30), app.stderr_text()
         assert app.stop() == 0
-    assert any(line.startswith("RX mt ") for line in app.lines)
+    assert any(line.startswith("RX mt ") for line in app.lines())
 
 
 def test_dccl_message_travels_as_protobuf(broker: BrokerProcess) -> None:

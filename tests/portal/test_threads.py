@@ -4,6 +4,7 @@ interprocess from a non-main thread, loop errors, signals, and the interface reg
 from __future__ import annotations
 
 import signal
+import subprocess
 import sys
 import threading
 import time
@@ -21,7 +22,7 @@ from gateway.goby.portal import (
     ThreadError,
 )
 from gateway.goby.portal.interface_registry import ENV_VAR, read_entries
-from gateway.goby.portal.testing import AppProcess, BrokerProcess, PortalClient, running_app
+from gateway.goby.portal.testing import BrokerProcess, PortalClient, app_process, running_app
 from tests.protobuf.sample_messages_pb2 import Sample, SampleAppConfig
 
 REPO = Path(__file__).resolve().parents[2]
@@ -204,16 +205,16 @@ def test_sigterm_shuts_an_app_down_cleanly_and_writes_the_registry(broker: Broke
     env[ENV_VAR] = str(registry_file)
     cmd = [sys.executable, "-m", "tests.portal.apps.sample_app", "--role=rx", "-a", "sig_rx", "-v",
            "--group", "sig", "--count", "1000"]
-    with AppProcess(cmd, env=env, cwd=REPO, log_path=tmp_path / "rx.log") as app:
+    with app_process(cmd, env=env, cwd=REPO, log_path=tmp_path / "rx.log") as app:
         with PortalClient(broker.interprocess_config(), "sig_tx") as tx:
             assert tx.wait_ready()
 
             def running() -> bool:
                 tx.publish("sig", Sample(a=1))
-                return app.wait_for("RX sig", 0.1) is not None
+                return app.wait_for_output("RX sig", 0.1) is not None
 
             assert tx.poll_until(running, 30), app.stderr_text()
-        app.process.send_signal(signal.SIGTERM)
+        app.send_signal(signal.SIGTERM)
         assert app.wait(20) == 0
         assert "received SIGTERM; shutting down" in app.stderr_text()
     entries = read_entries(registry_file)
@@ -222,11 +223,10 @@ def test_sigterm_shuts_an_app_down_cleanly_and_writes_the_registry(broker: Broke
 
 
 def test_example_config_of_an_app() -> None:
-    out = AppProcess([sys.executable, "-m", "tests.portal.apps.sample_app", "--role=rx", "--example_config"],
-                     cwd=REPO)
-    with out:
-        assert out.wait(30) == 0
-    text = "\n".join(out.lines)
+    out = subprocess.run([sys.executable, "-m", "tests.portal.apps.sample_app", "--role=rx", "--example_config"],
+                         cwd=REPO, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    text = out.stdout
     assert "interprocess {" in text and "platform: \"default_goby_platform\"" in text
     assert "role: \"echo\"" in text and "warp_factor: 1" in text
 

@@ -15,12 +15,11 @@ from pathlib import Path
 
 import pytest
 from translator_procs import (
-    ChildProcess,
     gateway_args,
     moosdb,
     plugin_env,
     running,
-    wait_until,
+    wait_showing_logs,
 )
 
 from gateway.goby.portal.testing import BrokerProcess, PortalClient, broker_process
@@ -28,6 +27,7 @@ from gateway.moos.testing import connected_comms, real_moos_skip_reason
 from translators.usv import groups as usv_groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
+from util.process import ChildProcess
 
 PLUGINS = "frontseat:usv_command:node_report"
 STARTUP_TIMEOUT_S = 90.0
@@ -73,7 +73,7 @@ def _probe_translator_clients(stack: Stack, count: int = 3) -> None:
         def enough() -> bool:
             sources.update(m.source() for m in watcher.fetch())
             return len(sources) >= count
-        wait_until(enough, STARTUP_TIMEOUT_S, f"{count} translators posting GOBY_MOOS_TRANSLATOR_TIME",
+        wait_showing_logs(enough, STARTUP_TIMEOUT_S, f"{count} translators posting GOBY_MOOS_TRANSLATOR_TIME",
                    *stack.children)
 
 
@@ -96,4 +96,4 @@ def stack(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFacto
         _probe_command_path(built)
         yield built
         for child in built.children:
-            assert child.alive(), f"{child.name} died during the tests\n{built.logs()}"
+            assert child.running, f"{child.name} died during the tests\n{built.logs()}"

@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
-from translator_procs import ORIGIN, ChildProcess, run_cli
+from translator_procs import ORIGIN, run_cli, start_child
 
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import USV, DesiredCourse, NodeStatus
@@ -93,7 +93,7 @@ def test_helm_drives_through_the_gateway_and_a_shore_command_switches_its_behavi
     bhv.write_text(BHV % {"waypoint_speed": WAYPOINT_SPEED, "loiter_speed": LOITER_SPEED})
     mission = tmp_path / "usv.moos"
     mission.write_text(MOOS % {"port": stack.moos_port, "lat": ORIGIN[0], "lon": ORIGIN[1], "bhv": bhv})
-    helm = ChildProcess(helm_kind, helm_command(helm_kind, mission), tmp_path)
+    helm = start_child(helm_kind, helm_command(helm_kind, mission), tmp_path)
     try:
         with PortalClient(stack.broker.interprocess_config(), name="frontseat_stand_in") as client, \
                 connected_comms(stack.moos_port, "watch_polygon_view", register=["VIEW_POLYGON"]) as watcher:
@@ -104,7 +104,7 @@ def test_helm_drives_through_the_gateway_and_a_shore_command_switches_its_behavi
             def drive_until(predicate, what: str) -> None:  # noqa: ANN001
                 deadline = time.monotonic() + TIMEOUT_S
                 while not predicate():
-                    assert helm.alive(), f"{helm_kind} exited\n{helm.output()}"
+                    assert helm.running, f"{helm_kind} exited\n{helm.output()}"
                     assert time.monotonic() < deadline, f"timed out: {what}\n{helm.output()[-3000:]}\n{stack.logs()}"
                     client.publish(groups.node_status, nav_at_origin())
                     client.poll(0.25)

@@ -102,4 +102,4 @@ def test_course_plugin_posts_contacts_and_commands(plugin_stack):
     client.publish(groups.usv_command, USVCommand(time=REFERENCE_S, desired_state=USVCommand.WAYPOINTS))
     mail_until(watcher, got, lambda: any(m.key() == "DEPLOY_STATE" for m in got), gateway, "DEPLOY_STATE")
     assert [(m.key(), m.string()) for m in got] == [("DEPLOY_STATE", "WAYPOINTS")]
-    assert gateway.proc is not None and gateway.proc.poll() is None
+    assert gateway.proc.running

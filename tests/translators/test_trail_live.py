@@ -7,7 +7,7 @@ import shutil
 import time
 
 import pytest
-from translator_procs import ORIGIN, ChildProcess
+from translator_procs import ORIGIN, start_child
 
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import USV, NodeStatus
@@ -74,7 +74,7 @@ def test_real_phelmivp_trails_a_contact_known_only_from_our_node_report(tmp_path
         cfg.app.geodesy.lat_origin, cfg.app.geodesy.lon_origin = ORIGIN
         mission = tmp_path / "auv.moos"
         mission.write_text(MOOS % {"port": db.port, "lat": ORIGIN[0], "lon": ORIGIN[1], "bhv": bhv})
-        helm = ChildProcess("pHelmIvP", ["pHelmIvP", str(mission)], tmp_path)
+        helm = start_child("pHelmIvP", ["pHelmIvP", str(mission)], tmp_path)
         try:
             with hosted_translators(cfg, NodeReportTranslation), \
                     connected_comms(db.port, "auv_nav", register=["DESIRED_HEADING", "DESIRED_SPEED",
@@ -86,7 +86,7 @@ def test_real_phelmivp_trails_a_contact_known_only_from_our_node_report(tmp_path
                 # Ownship at the origin heading north; the USV 200 m east heading east: the trail point (50 m
                 # behind it) is due east, so a helm that parsed the contact steers about 90 degrees.
                 while not (latest.get("DESIRED_SPEED", 0) > 0 and "NODE_REPORT" in latest):
-                    assert helm.alive(), helm.output()
+                    assert helm.running, helm.output()
                     assert time.monotonic() < deadline, f"pHelmIvP never trailed the contact: {latest}\n" \
                         f"{helm.output()[-3000:]}"
                     for name, value in (("NAV_X", 0.0), ("NAV_Y", 0.0), ("NAV_HEADING", 0.0), ("NAV_SPEED", 0.0),

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 
 import pytest
-from translator_procs import ChildProcess, run_cli, wait_until
+from translator_procs import run_cli, start_child, wait_showing_logs
 
 from gateway.goby.portal.testing import PortalClient, broker_process
 from translators.apps.usv_command import (
@@ -61,13 +61,13 @@ def test_describe_ack():
 def test_without_a_translator_the_command_is_not_acknowledged(tmp_path):
     """usv-manager answers but no gateway does: the CLI reports it and exits 3 after its timeout."""
     with broker_process(tmp_path, platform="shore") as broker:
-        manager = ChildProcess("usv_manager", [sys.executable, "-m", "translators.apps.usv_manager", "-v"], tmp_path,
+        manager = start_child("usv_manager", [sys.executable, "-m", "translators.apps.usv_manager", "-v"], tmp_path,
                                broker.env())
         try:
             with PortalClient(broker.interprocess_config(), name="probe") as client:
                 acks = client.collect(usv_groups.usv_command_ack, USVCommandAck)
                 assert client.wait_subscribed()
-                wait_until(lambda: client.publish(usv_groups.shore_usv_command, USVCommand(
+                wait_showing_logs(lambda: client.publish(usv_groups.shore_usv_command, USVCommand(
                     time=7.0, desired_state=USVCommand.WAYPOINTS)) or client.poll_until(lambda: bool(acks), 0.5),
                     60, "usv-manager to answer", manager)
             result = run_cli(["waypoints", "--timeout", "3"], broker.env(), tmp_path)

@@ -9,61 +9,27 @@ from __future__ import annotations
 
 import contextlib
 import os
-import signal
 import subprocess
 import sys
-import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
-from gateway.moos.testing import free_port, moosdb_process, port_open, wait_for
+from gateway.moos.testing import moosdb_process
+from util.process import ChildProcess, WaitTimeout, wait_until
 
 ORIGIN = (43.8253, -70.3304)  # s1_alpha (ivp_helm.md §7.3)
 
 
-class ChildProcess:
-    """One child process with stdout/stderr in files; ``stop`` is SIGTERM, then SIGKILL after a grace period."""
-
-    def __init__(self, name: str, args: list[str], workdir: Path, env: dict[str, str] | None = None) -> None:
-        self.name = name
-        self.out_path = workdir / f"{name}.out"
-        self.err_path = workdir / f"{name}.err"
-        with open(self.out_path, "wb") as out, open(self.err_path, "wb") as err:
-            self.proc = subprocess.Popen(args, stdout=out, stderr=err, cwd=workdir, env=env)
-
-    def output(self) -> str:
-        return self.out_path.read_text(errors="replace") + self.err_path.read_text(errors="replace")
-
-    def alive(self) -> bool:
-        return self.proc.poll() is None
-
-    def stop(self, grace_s: float = 15.0) -> int:
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-            try:
-                self.proc.wait(grace_s)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(10)
-        return self.proc.returncode
+def start_child(name: str, args: list[str], workdir: Path, env: dict[str, str] | None = None) -> ChildProcess:
+    """``args`` started as a child process logging to ``workdir/<name>.log``; the caller stops it."""
+    return ChildProcess(args, workdir / f"{name}.log", name=name, cwd=workdir, env=env).start()
 
 
 @contextlib.contextmanager
 def moosdb(kind: str, workdir: Path, community: str = "usv") -> Iterator[int]:
     """A MOOSDB child process (``kind`` "ours" = moos-db, "real" = the C++ MOOSDB); yields its port."""
-    if kind == "ours":
-        with moosdb_process(workdir, community=community) as db:
-            yield db.port
-        return
-    port = free_port()
-    child = ChildProcess("MOOSDB", ["MOOSDB", f"--moos_port={port}", f"--moos_community={community}",
-                                    "--moos_suicide_disable"], workdir)
-    try:
-        if not wait_for(lambda: port_open(port) or not child.alive(), 20) or not child.alive():
-            raise RuntimeError(f"MOOSDB did not start: {child.output()}")
-        yield port
-    finally:
-        child.stop(5)
+    with moosdb_process(workdir, community=community, program=None if kind == "ours" else "MOOSDB") as db:
+        yield db.port
 
 
 def gateway_args(moos_port: int, origin: tuple[float, float] | None = ORIGIN) -> list[str]:
@@ -76,11 +42,11 @@ def gateway_args(moos_port: int, origin: tuple[float, float] | None = ORIGIN) ->
 @contextlib.contextmanager
 def running(name: str, args: list[str], workdir: Path, env: dict[str, str]) -> Iterator[ChildProcess]:
     """A child process for the duration of the block; its output is attached to failures by the caller."""
-    child = ChildProcess(name, args, workdir, env)
+    child = start_child(name, args, workdir, env)
     try:
         yield child
     finally:
-        child.stop()
+        child.stop(15)
 
 
 def plugin_env(broker_env: dict[str, str], plugins: str) -> dict[str, str]:
@@ -95,14 +61,13 @@ def run_cli(args: list[str], env: dict[str, str], workdir: Path, timeout_s: floa
                           capture_output=True, text=True, timeout=timeout_s)
 
 
-def wait_until(predicate, timeout_s: float, what: str, *children: ChildProcess) -> None:  # noqa: ANN001
-    """Poll ``predicate`` until true; on timeout fail with ``what`` and the children's output."""
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > deadline:
-            logs = "\n".join(f"--- {c.name} ---\n{c.output()[-4000:]}" for c in children)
-            raise AssertionError(f"timed out after {timeout_s} s waiting for {what}\n{logs}")
-        time.sleep(0.05)
+def wait_showing_logs(predicate: Callable[[], object], timeout_s: float, what: str, *children: ChildProcess) -> None:
+    """:func:`util.process.wait_until`, failing with the children's output attached."""
+    try:
+        wait_until(predicate, timeout_s, what)
+    except WaitTimeout as exc:
+        logs = "\n".join(f"--- {c.name} ---\n{c.output()[-4000:]}" for c in children)
+        raise AssertionError(f"{exc}\n{logs}") from None
 
 
 def environ_without_plugins() -> dict[str, str]:

@@ -14,10 +14,8 @@ from __future__ import annotations
 
 import json
 import os
-import selectors
+import re
 import shutil
-import signal
-import subprocess
 import sys
 import tempfile
 import threading
@@ -39,6 +37,7 @@ from gateway.goby.portal.thread import app_name_of, interprocess_config_of
 from gateway.goby.portal.timeutil import SystemClock
 from gateway.goby.portal.transports import ThreadTransports
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from util.process import ChildProcess, ProcessError
 
 #: Unix socket paths are limited to 107 bytes; longer temp dirs fall back to a short one under /tmp.
 _MAX_IPC_BASE = 90
@@ -61,8 +60,10 @@ class BrokerProcess:
         self.socket_base = str(base)
         self.extra_args = list(extra_args or [])
         self.startup_timeout = startup_timeout
-        self.process: subprocess.Popen[str] | None = None
+        self.process: ChildProcess | None = None  # while running
+        self._child: ChildProcess | None = None  # kept across restarts: one log
         self.log_path = Path(log_path) if log_path is not None else None
+        self._out_path = Path(self._own_dir or directory) / f"goby-broker-{platform}.out"
         self.endpoints: dict[str, Any] = {}
         self.manager_port = 0
 
@@ -93,66 +94,39 @@ class BrokerProcess:
 
     def start(self) -> BrokerProcess:
         """Start the broker and wait for its ready line; raises ``PortalError`` if it does not come up."""
-        if self.process is not None and self.process.poll() is None:
+        if self.process is not None and self.process.running:
             return self
         cfg = self._config()
         if self.tcp and not self.manager_port:
             cfg.tcp_port = 0
         args = [sys.executable, "-m", "gateway.apps.goby_broker",
                 "--interprocess", text_format.MessageToString(cfg, as_one_line=True), *self.extra_args]
-        if self.log_path is not None:
-            with open(self.log_path, "a") as log_file:  # the child keeps its own copy of the descriptor
-                self.process = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=log_file, text=True)
-        else:
-            self.process = subprocess.Popen(args, stdout=subprocess.PIPE, text=True)
-        line = self._read_ready_line()
-        self.endpoints = json.loads(line[len(READY_PREFIX):])
+        if self._child is None:
+            self._child = ChildProcess(args, self._out_path, name=f"goby-broker ({self.platform})",
+                                       stderr_path=self.log_path)
+        self._child.args = args
+        self.process = self._child
+        try:
+            ready = self.process.start().wait_ready(re.escape(READY_PREFIX) + "(.*)", timeout=self.startup_timeout)
+        except ProcessError as exc:
+            self.process = None
+            raise PortalError(f"goby-broker for platform {self.platform!r} did not become ready: {exc}") from None
+        assert ready is not None
+        self.endpoints = json.loads(ready.group(1))
         if self.tcp and not self.manager_port:
             self.manager_port = int(self.endpoints["manager"].rsplit(":", 1)[1])
         return self
 
-    def _read_ready_line(self) -> str:
-        assert self.process is not None and self.process.stdout is not None
-        deadline = time.monotonic() + self.startup_timeout
-        with selectors.DefaultSelector() as sel:
-            sel.register(self.process.stdout, selectors.EVENT_READ)
-            while time.monotonic() < deadline:
-                if sel.select(timeout=0.2):
-                    line = self.process.stdout.readline()
-                    if line.startswith(READY_PREFIX):
-                        return line.strip()
-                    if not line and self.process.poll() is not None:
-                        break
-                elif self.process.poll() is not None:
-                    break
-        code = self.process.poll()
-        self.stop()
-        raise PortalError(f"goby-broker for platform {self.platform!r} did not become ready (exit code {code})")
-
     def stop(self, timeout: float = 10.0) -> int | None:
         """SIGTERM, wait, SIGKILL if needed; returns the exit code (idempotent)."""
         proc, self.process = self.process, None
-        if proc is None:
-            return None
-        if proc.poll() is None:
-            proc.send_signal(signal.SIGTERM)
-            try:
-                proc.wait(timeout)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
-        if proc.stdout is not None:
-            proc.stdout.close()
-        return proc.returncode
+        return proc.stop(grace=timeout) if proc is not None else None
 
     def kill(self) -> None:
         """SIGKILL (a crash); the IPC files stay behind, as after a real crash."""
         proc, self.process = self.process, None
         if proc is not None:
             proc.kill()
-            proc.wait()
-            if proc.stdout is not None:
-                proc.stdout.close()
 
     def stderr_text(self) -> str:
         """The broker's log so far (only with ``log_path``)."""
@@ -309,90 +283,10 @@ class PortalClient:
         self.close()
 
 
-class AppProcess:
-    """An application subprocess whose stdout lines the test can wait for; stderr goes to ``log_path``.
-
-    ``wait_for("RX DONE")`` reads stdout until a line contains the text (or a predicate over the line holds).
-    ``stop()`` sends SIGTERM, then SIGKILL after ``timeout``; it is idempotent and returns the exit code.
-    """
-
-    def __init__(self, args: list[str], *, env: dict[str, str] | None = None, cwd: str | os.PathLike[str] | None = None,
-                 log_path: str | os.PathLike[str] | None = None) -> None:
-        self.args = args
-        self.log_path = Path(log_path) if log_path is not None else None
-        self._log = open(self.log_path, "w") if self.log_path is not None else subprocess.DEVNULL  # noqa: SIM115
-        self.process: subprocess.Popen[str] = subprocess.Popen(
-            args, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=self._log, text=True
-        )
-        self.lines: list[str] = []
-        self._selector = selectors.DefaultSelector()
-        assert self.process.stdout is not None
-        self._selector.register(self.process.stdout, selectors.EVENT_READ)
-        self.returncode: int | None = None
-
-    def read_available(self, timeout_s: float = 0.0) -> int:
-        """Read whatever stdout lines are ready (waiting up to ``timeout_s`` for the first)."""
-        count = 0
-        assert self.process.stdout is not None
-        while self._selector.select(timeout=timeout_s if count == 0 else 0):
-            line = self.process.stdout.readline()
-            if not line:
-                break
-            self.lines.append(line.rstrip("\n"))
-            count += 1
-        return count
-
-    def wait_for(self, what: str | Callable[[str], bool], timeout_s: float = 30.0) -> str | None:
-        """The first stdout line (already read or new) that contains ``what`` / satisfies it; None on timeout."""
-        test = (lambda line: what in line) if isinstance(what, str) else what
-        checked = 0
-        deadline = time.monotonic() + timeout_s
-        while True:
-            for line in self.lines[checked:]:
-                if test(line):
-                    return line
-            checked = len(self.lines)
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                return None
-            if not self.read_available(min(0.1, remaining)) and self.process.poll() is not None:
-                self.read_available(0)
-                if len(self.lines) == checked:
-                    return None
-
-    def wait(self, timeout_s: float = 30.0) -> int | None:
-        """Wait for the process to exit by itself (reading its output); None on timeout."""
-        deadline = time.monotonic() + timeout_s
-        while self.process.poll() is None and time.monotonic() < deadline:
-            self.read_available(0.1)
-        self.read_available(0)
-        return self.process.poll()
-
-    def stderr_text(self) -> str:
-        if self.log_path is None:
-            return ""
-        return self.log_path.read_text()
-
-    def stop(self, timeout_s: float = 10.0) -> int | None:
-        if self.returncode is None:
-            if self.process.poll() is None:
-                self.process.send_signal(signal.SIGTERM)
-                try:
-                    self.process.wait(timeout_s)
-                except subprocess.TimeoutExpired:
-                    self.process.kill()
-                    self.process.wait()
-            self.read_available(0)
-            self.returncode = self.process.returncode
-            self._selector.close()
-            assert self.process.stdout is not None
-            self.process.stdout.close()
-            if self._log is not subprocess.DEVNULL:
-                self._log.close()  # type: ignore[union-attr]
-        return self.returncode
-
-    def __enter__(self) -> AppProcess:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.stop()
+def app_process(args: list[str], log_path: str | os.PathLike[str], *, env: dict[str, str] | None = None,
+                cwd: str | os.PathLike[str] | None = None) -> ChildProcess:
+    """An application started as a child process: its stdout (what tests wait for: ``wait_for_output``, ``lines()``)
+    in ``<log_path>.out``, its stderr (the log) in ``log_path`` (``stderr_text()``)."""
+    log_path = Path(log_path)
+    return ChildProcess(args, log_path.with_name(log_path.name + ".out"), stderr_path=log_path, env=env,
+                        cwd=cwd).start()
