@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 import os
 import random
-import subprocess
+import re
 import sys
 import tempfile
 import time
@@ -22,10 +22,10 @@ from pathlib import Path
 
 from bench.stats import median_p99
 from gateway.goby.portal.testing import PortalClient, broker_process
-from launch.config import free_tcp_port
 from launch.liaison.portal_side import READY_PREFIX
 from launch.liaison.testing import PROFILE_PREFIX as PROFILE_MARKER
 from launch.liaison.testing import browser_skip_reason, chromium
+from util.process import ChildProcess, ProcessError, free_port
 
 RECORDER = """
 window._drawn = [];
@@ -66,20 +66,17 @@ def chromium_pids(profile_marker: str) -> list[int]:
     return pids
 
 
-def start_liaison(broker, update_freq: float, log: Path) -> tuple[subprocess.Popen, str]:
-    port = free_tcp_port()
+def start_liaison(broker, update_freq: float, log: Path) -> tuple[ChildProcess, str]:
+    port = free_port()
     cfg = (f'interprocess {{ {broker.interprocess_text()} }} http_address: "127.0.0.1" http_port: {port} '
            f"update_freq: {update_freq}")
     path = log.with_suffix(".cfg")
     path.write_text(cfg)
-    out = open(log, "w")
-    proc = subprocess.Popen([sys.executable, "-m", "launch.apps.goby_liaison", str(path)], stdout=out,
-                            stderr=subprocess.STDOUT)
-    deadline = time.monotonic() + 30
-    while READY_PREFIX not in log.read_text():
-        if proc.poll() is not None or time.monotonic() > deadline:
-            raise SystemExit(f"goby-liaison did not start:\n{log.read_text()}")
-        time.sleep(0.1)
+    proc = ChildProcess([sys.executable, "-m", "launch.apps.goby_liaison", str(path)], log, name="goby-liaison")
+    try:
+        proc.start().wait_ready(re.escape(READY_PREFIX), timeout=30)
+    except ProcessError as exc:
+        raise SystemExit(str(exc)) from None
     return proc, f"http://127.0.0.1:{port}"
 
 
@@ -154,8 +151,7 @@ def main(argv: list[str] | None = None) -> int:
                         sparse = run_latency(driver, client, url, args.seconds, period_s=0.25, jitter=True)
                         liaison_cpu, browser_cpu, rate = run_load(driver, client, url, proc.pid, args.seconds)
                     finally:
-                        proc.terminate()
-                        proc.wait(10)
+                        proc.stop()
                     rows.append((freq, *median_p99(latencies), *median_p99(sparse), rate, liaison_cpu, browser_cpu))
     print(f"{'update_freq':>11} | {'50 Hz group: median':>19} {'p99 ms':>7} | {'~4 Hz group: median':>19} {'p99 ms':>7} | "
           f"{'pubs/s':>6} {'liaison CPU':>11} {'browser CPU':>11}")

@@ -14,7 +14,6 @@ import contextlib
 import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import threading
@@ -24,7 +23,8 @@ from pathlib import Path
 
 from bench.stats import median_p99
 from gateway.moos.factory import choose_client, pymoos_available
-from gateway.moos.testing import real_moos_skip_reason, real_moosdb, stop_process
+from gateway.moos.testing import moosdb_process, real_moos_skip_reason
+from util.process import ChildProcess
 
 HERE = Path(__file__).resolve().parents[1]
 
@@ -104,36 +104,27 @@ def worker(args: argparse.Namespace) -> int:
 
 @contextlib.contextmanager
 def child(role: str, client: str, port: int, name: str, var: str = "", count: int = 0,
-          seconds: float = 60) -> Iterator[subprocess.Popen[str]]:
+          seconds: float = 60) -> Iterator[ChildProcess]:
     cmd = [sys.executable, "-m", "bench.bench_moos", "--worker", role, "--client", client, "--port", str(port),
            "--name", name, "--var", var, "--count", str(count), "--seconds", str(seconds)]
-    log = tempfile.NamedTemporaryFile(prefix=f"bench_moos_{name}_", suffix=".log", delete=False)
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=log, text=True, cwd=HERE)
-    proc.log_path = log.name  # type: ignore[attr-defined]
-    log.close()
+    logs = Path(tempfile.mkdtemp(prefix=f"bench_moos_{name}_"))
+    proc = ChildProcess(cmd, logs / "stdout", name=name, stderr_path=logs / "stderr.log", cwd=HERE).start()
     try:
-        for line in proc.stdout:  # type: ignore[union-attr]  # skip anything a C++ client prints first
-            if line.strip() == "ready":
-                break
-        else:
-            raise RuntimeError(f"{role} worker exited before it was ready ({proc.wait()})")
+        proc.wait_ready(r"^ready$", timeout=60)  # skip anything a C++ client prints first
         yield proc
     finally:
-        if proc.poll() is None:
-            try:
-                proc.wait(seconds + 10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+        if proc.wait(seconds + 10) is None:
+            proc.kill()
+        proc.stop()
 
 
-def sink_result(proc: subprocess.Popen[str]) -> dict[str, object]:
-    out = proc.stdout.read()  # type: ignore[union-attr]  # same buffered reader that saw "ready"
+def sink_result(proc: ChildProcess) -> dict[str, object]:
     proc.wait(60)
+    out = proc.output()
     # A C++ client may print text without a newline just before our JSON, so look for the JSON itself.
     lines = ["{" + line.split("{", 1)[1] for line in out.splitlines() if '{"received"' in line]
     if not lines:
-        tail = Path(proc.log_path).read_text(errors="replace")[-300:]  # type: ignore[attr-defined]
+        tail = proc.stderr_text()[-300:]
         print(f"  a sink failed (exit {proc.returncode}): {tail!r} {out[-300:]!r}", file=sys.stderr)
         return {"received": 0, "in_order": False, "first": 0.0, "last": 0.0}
     return json.loads(lines[-1])
@@ -198,19 +189,9 @@ def one_way(kind: str, port: int, n: int, subscribers: int = 1, payload: str | N
 @contextlib.contextmanager
 def start_db(kind: str) -> Iterator[tuple[int, int]]:
     """Yield (port, pid) of a running DB: ``ours`` (moos-db) or ``MOOSDB`` (the C++ one)."""
-    if kind == "ours":
-        proc = subprocess.Popen([sys.executable, "-m", "gateway.apps.moos_db", "--moos_port=0",
-                                 "--moos_community=bench"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                                text=True, cwd=HERE)
-        line = proc.stdout.readline()  # type: ignore[union-attr]
-        port = int(line.rsplit(":", 1)[1])
-        try:
-            yield port, proc.pid
-        finally:
-            stop_process(proc, 10)
-        return
-    with tempfile.TemporaryDirectory() as workdir, real_moosdb(workdir, community="bench") as (port, proc):
-        yield port, proc.pid
+    with tempfile.TemporaryDirectory() as workdir, \
+            moosdb_process(workdir, community="bench", program=None if kind == "ours" else "MOOSDB") as db:
+        yield db.port, db.pid
 
 
 def process_stats(pid: int) -> tuple[float, float]:

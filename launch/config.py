@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import socket
 import string
 import sys
 from collections.abc import Mapping
@@ -49,13 +48,6 @@ def fail(message: str) -> int:
     print(INVALID_BANNER, flush=True)
     print(f"invalid configuration: {message}", file=sys.stderr, flush=True)
     return 1
-
-
-def free_tcp_port(host: str = "127.0.0.1") -> int:
-    """An ephemeral TCP port that is free right now (for tests and side-by-side missions)."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
-        sock.bind((host, 0))
-        return int(sock.getsockname()[1])
 
 
 def text_format_string(value: str) -> str:

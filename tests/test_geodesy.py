@@ -4,17 +4,10 @@ from __future__ import annotations
 
 import pytest
 
+from tests.geodesy_reference import ORIGIN, REFERENCE
 from util.geodesy import UTMGeodesy, utm_zone
 
-FOREST_LAKE = (43.8253, -70.3304)
-# (x, y) -> (lat, lon), computed independently with pyproj/PROJ and a port of MOOS's Gantz code.
-REFERENCE = [
-    ((0.0, -20.0), (43.82511997, -70.33039600)),
-    ((60.0, -40.0), (43.82494863, -70.32964602)),
-    ((180.0, -100.0), (43.82442590, -70.32814209)),
-    ((100.0, 100.0), (43.82621460, -70.32917667)),
-    ((1000.0, -1000.0), (43.81644267, -70.31776886)),
-]
+FOREST_LAKE = ORIGIN
 
 
 @pytest.fixture(scope="module")

@@ -84,7 +84,7 @@ def handle_signals(callback: Callable[[int], None] | None = None,
         return
 
     def handler(signum: int, _frame: object) -> None:
-        log.info("received %s", signal.Signals(signum).name)
+        log.debug("received %s", signal.Signals(signum).name)
         event.set()
         if callback is not None:
             callback(signum)
@@ -160,30 +160,28 @@ class ChildProcess:
         return self
 
     def wait_for_output(self, pattern: Ready | Callable[[str], bool], timeout: float = 30.0) -> re.Match[str] | None:
-        """Wait until a line of this run's output matches ``pattern`` (a regex searched in each line, or a predicate
-        over the line); return the match (for a predicate, a match of the whole line), or None when the timeout passes
-        or the child ends without printing it."""
+        """Wait until this run's output matches ``pattern`` and return the match; None when ``timeout`` passes or the
+        child ends without printing it.
+
+        A regex (a ``str`` is compiled with ``re.MULTILINE``, so ``^``/``$`` are line ends) is searched in the
+        complete lines printed so far, so it may span lines; a predicate is tried on each line (the match is then
+        the whole line).
+        """
         if callable(pattern) and not isinstance(pattern, re.Pattern):
             test = pattern
 
-            def find(line: str) -> re.Match[str] | None:
-                return re.fullmatch(r".*", line) if test(line) else None
+            def find(text: str) -> re.Match[str] | None:
+                line = next((line for line in text.splitlines() if test(line)), None)
+                return None if line is None else re.fullmatch(".*", line)
         else:
-            regex = re.compile(pattern) if isinstance(pattern, str) else pattern
-            find = regex.search
+            find = (re.compile(pattern, re.MULTILINE) if isinstance(pattern, str) else pattern).search
         deadline = time.monotonic() + timeout
-        checked = 0
         while True:
             ended = not self.running  # read once more after the child ended: it may have printed just before
             text = self.output()
-            complete = text.splitlines() if ended or text.endswith("\n") else text.splitlines()[:-1]
-            for line in complete[checked:]:
-                found = find(line)
-                if found:
-                    return found
-            checked = len(complete)
-            if ended or time.monotonic() >= deadline:
-                return None
+            found = find(text if ended else text[: text.rfind("\n") + 1])
+            if found or ended or time.monotonic() >= deadline:
+                return found
             time.sleep(0.02)
 
     def wait_ready(self, pattern: Ready | None = None, *, port: int | None = None, host: str = "127.0.0.1",

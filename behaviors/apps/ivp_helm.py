@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import signal
 import threading
 import time
 from pathlib import Path
@@ -22,6 +21,7 @@ from behaviors.helm.helm import Helm, Post
 from gateway.moos import MissionFileError, MoosClock, comms
 from gateway.moos.mission_file import MissionFile
 from util.logsetup import add_verbosity_argument, configure_logging
+from util.process import handle_signals
 
 log = logging.getLogger(__name__)
 DEFAULT_APP_NAME = "pHelmIvP"
@@ -187,18 +187,17 @@ def main(argv: list[str] | None = None) -> int:
     except MissionFileError as exc:
         log.error("%s", exc)
         return 2
-    stop = threading.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop.set())
-    app.start()
-    log.info("%s connecting to %s:%d (state %s)", app.name, app.host, app.port, app.state)
-    try:
-        while not stop.wait(0.2):
-            if not app.helm_thread_alive():
-                log.critical("ivp-helm: the helm thread has stopped (%r); exiting, no helm is running", app.failure)
-                return 1
-    finally:
-        app.stop()
+    with handle_signals() as stop:
+        app.start()
+        log.info("%s connecting to %s:%d (state %s)", app.name, app.host, app.port, app.state)
+        try:
+            while not stop.wait(0.2):
+                if not app.helm_thread_alive():
+                    log.critical("ivp-helm: the helm thread has stopped (%r); exiting, no helm is running",
+                                 app.failure)
+                    return 1
+        finally:
+            app.stop()
     return 0
 
 

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import signal
 import threading
 import time
 from pathlib import Path
@@ -18,6 +17,7 @@ from behaviors.node_reporter import REGISTRATIONS, NodeReporter, NodeReporterCon
 from gateway.moos import MissionFileError, MoosClock, comms
 from gateway.moos.mission_file import MissionFile
 from util.logsetup import add_verbosity_argument, configure_logging
+from util.process import handle_signals
 
 log = logging.getLogger(__name__)
 DEFAULT_APP_NAME = "pNodeReporter"
@@ -83,17 +83,10 @@ def main(argv: list[str] | None = None) -> int:
     except MissionFileError as exc:
         log.error("%s", exc)
         return 2
-    stop = threading.Event()
-
-    def on_signal(*_: object) -> None:
-        stop.set()
-        app.wake()
-
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, on_signal)
-    log.info("%s reporting %s on %s:%d", app.name, app.mission.community, app.mission.server_host,
-             app.mission.server_port)
-    app.run(stop)
+    with handle_signals(lambda _signum: app.wake()) as stop:
+        log.info("%s reporting %s on %s:%d", app.name, app.mission.community, app.mission.server_host,
+                 app.mission.server_port)
+        app.run(stop)
     return 0
 
 

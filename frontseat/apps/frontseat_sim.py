@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
-import threading
 
 from frontseat.simulator.server import SimulatorServer
 from util.logsetup import add_verbosity_argument, configure_logging
+from util.process import handle_signals
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -37,10 +36,7 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:
         print(f"frontseat-sim: cannot listen on {args.host}:{port}: {exc}", file=sys.stderr)
         return 1
-    done = threading.Event()
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: done.set())
-    with server:
+    with handle_signals() as done, server:
         print(f"frontseat-sim listening on {server.host}:{server.port}", flush=True)
         while not done.wait(0.5):
             if not server.running:

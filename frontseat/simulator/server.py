@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 from frontseat.simulator.model import Simulation
 from frontseat.simulator.protocol import DELIMITER
+from util.sockets import accept_client
 
 log = logging.getLogger(__name__)
 
@@ -131,16 +132,11 @@ class SimulatorServer:
                 self._flush(client)
 
     def _accept(self) -> None:
-        try:
-            sock, addr = self._listener.accept()
-        except (BlockingIOError, InterruptedError):
+        accepted = accept_client(self._listener)
+        if accepted is None:
             return
-        except OSError as exc:
-            log.warning("accept failed: %s", exc)
-            return
-        sock.setblocking(False)
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        client = _Client(sock, f"{addr[0]}:{addr[1]}")
+        sock, peer = accepted
+        client = _Client(sock, peer)
         self._clients[sock] = client
         self._selector.register(sock, selectors.EVENT_READ, client)
         log.info("client %s connected (%d connected)", client.peer, len(self._clients))

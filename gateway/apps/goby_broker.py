@@ -10,14 +10,13 @@ from __future__ import annotations
 import json
 import logging
 import os
-import signal
 import sys
-import threading
 
 from gateway.goby.portal.broker import READY_PREFIX, Broker, BrokerError
 from gateway.goby.portal.config import load_for_run
 from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
 from util.logsetup import configure_logging
+from util.process import handle_signals
 
 log = logging.getLogger(__name__)
 
@@ -30,31 +29,22 @@ def main(argv: list[str] | None = None) -> int:
     configure_logging(loaded.verbosity, cfg.app.name)
     if not cfg.interprocess.HasField("platform"):
         log.warning("Using default platform name of %s", cfg.interprocess.platform)
-    stop = threading.Event()
-
-    def on_signal(signum: int, _frame: object) -> None:
-        log.info("received %s; stopping", signal.Signals(signum).name)
-        stop.set()
-
-    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     broker = Broker(cfg)
-    try:
+    with handle_signals() as stop:
         try:
-            broker.start()
-        except BrokerError as exc:
-            log.critical("%s", exc)
-            return 1
-        info = {"platform": cfg.interprocess.platform, **broker.endpoints(), "pid": os.getpid()}
-        print(READY_PREFIX + json.dumps(info), flush=True)
-        log.info("=== goby-broker is ready ===")
-        while not stop.wait(1.0):
-            pass
-        return 0
-    finally:
-        broker.stop()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-
+            try:
+                broker.start()
+            except BrokerError as exc:
+                log.critical("%s", exc)
+                return 1
+            info = {"platform": cfg.interprocess.platform, **broker.endpoints(), "pid": os.getpid()}
+            print(READY_PREFIX + json.dumps(info), flush=True)
+            log.info("=== goby-broker is ready ===")
+            while not stop.wait(1.0):
+                pass
+            return 0
+        finally:
+            broker.stop()
 
 if __name__ == "__main__":
     sys.exit(main())

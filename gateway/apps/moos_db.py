@@ -11,7 +11,6 @@ from __future__ import annotations
 import argparse
 import logging
 import math
-import signal
 import sys
 from pathlib import Path
 
@@ -20,6 +19,7 @@ from gateway.moos.mission_file import MissionFile
 from gateway.moos.server import MoosDB
 from util.cli import bounded_number, positive_number
 from util.logsetup import add_verbosity_argument, configure_logging
+from util.process import handle_signals
 
 log = logging.getLogger(__name__)
 
@@ -119,15 +119,10 @@ def main(argv: list[str] | None = None) -> int:
         log.error("cannot start the MOOSDB on %s:%d: %s", args.moos_address, port, exc)
         return 1
 
-    def _stop(signum: int, _frame: object) -> None:
-        log.info("signal %d: stopping", signum)
+    with handle_signals(lambda _signum: server.stop()):
+        print(f"MOOSDB {community} listening on {server.host}:{server.port}", flush=True)
+        server.serve_forever()
         server.stop()
-
-    signal.signal(signal.SIGINT, _stop)
-    signal.signal(signal.SIGTERM, _stop)
-    print(f"MOOSDB {community} listening on {server.host}:{server.port}", flush=True)
-    server.serve_forever()
-    server.stop()
     return 0
 
 

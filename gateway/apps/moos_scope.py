@@ -13,7 +13,6 @@ import argparse
 import logging
 import signal
 import sys
-import threading
 import time
 
 from gateway.apps.moos_tool_args import (
@@ -26,6 +25,7 @@ from gateway.moos.client import comms
 from gateway.moos.clock import MoosClock
 from gateway.moos.message import MoosMessage
 from util.logsetup import add_verbosity_argument, configure_logging
+from util.process import handle_signals
 
 log = logging.getLogger(__name__)
 
@@ -91,7 +91,6 @@ def main(argv: list[str] | None = None) -> int:
     client = comms(clock=clock)
     latest: dict[str, MoosMessage] = {}
     watched = list(names)
-    stop = threading.Event()
 
     def on_connect() -> bool:
         for name in names:
@@ -102,43 +101,42 @@ def main(argv: list[str] | None = None) -> int:
 
     client.set_on_connect_callback(on_connect)
     client.run(host, port, args.name)
-    if not (args.once or args.duration):
-        signal.signal(signal.SIGINT, lambda *_: stop.set())
-    try:
-        if not client.wait_until_connected(args.connect_timeout * 1000):
-            reason = client.get_fatal_error() or f"no DB at {host}:{port} within {args.connect_timeout:g} s"
-            print(f"moos-scope: cannot connect: {reason}", file=sys.stderr)
-            return 1
-        if warp is None:  # neither --moos_time_warp nor MOOSTimeWarp: use the DB's, as moos-poke does
-            adopt_db_time_warp(client, clock)
-        start = clock.time()
-        if args.once:
-            deadline = time.monotonic() + args.timeout
-        elif args.duration is not None:
-            deadline = time.monotonic() + args.duration
-        else:
-            deadline = float("inf")
-        next_draw = time.monotonic()
-        while not stop.is_set():
-            for msg in client.fetch():
-                latest[msg.key()] = msg
-                if args.all and msg.key() not in watched:
-                    watched.append(msg.key())
-            now = time.monotonic()
+    with handle_signals(signals=(signal.SIGINT,)) as stop:
+        try:
+            if not client.wait_until_connected(args.connect_timeout * 1000):
+                reason = client.get_fatal_error() or f"no DB at {host}:{port} within {args.connect_timeout:g} s"
+                print(f"moos-scope: cannot connect: {reason}", file=sys.stderr)
+                return 1
+            if warp is None:  # neither --moos_time_warp nor MOOSTimeWarp: use the DB's, as moos-poke does
+                adopt_db_time_warp(client, clock)
+            start = clock.time()
             if args.once:
-                if (names and all(n in latest for n in names)) or now >= deadline:
-                    print(render_table(watched, latest, start), flush=True)
-                    return 0 if all(n in latest for n in names) else 2
-            elif now >= next_draw:
-                clear = "\x1b[2J\x1b[H" if sys.stdout.isatty() else ""
-                print(clear + render_table(sorted(watched) if args.all else watched, latest, start), flush=True)
-                next_draw = now + args.refresh
-            if now >= deadline:
-                return 0
-            stop.wait(0.02)
-        return 0
-    finally:
-        client.close(True)
+                deadline = time.monotonic() + args.timeout
+            elif args.duration is not None:
+                deadline = time.monotonic() + args.duration
+            else:
+                deadline = float("inf")
+            next_draw = time.monotonic()
+            while not stop.is_set():
+                for msg in client.fetch():
+                    latest[msg.key()] = msg
+                    if args.all and msg.key() not in watched:
+                        watched.append(msg.key())
+                now = time.monotonic()
+                if args.once:
+                    if (names and all(n in latest for n in names)) or now >= deadline:
+                        print(render_table(watched, latest, start), flush=True)
+                        return 0 if all(n in latest for n in names) else 2
+                elif now >= next_draw:
+                    clear = "\x1b[2J\x1b[H" if sys.stdout.isatty() else ""
+                    print(clear + render_table(sorted(watched) if args.all else watched, latest, start), flush=True)
+                    next_draw = now + args.refresh
+                if now >= deadline:
+                    return 0
+                stop.wait(0.02)
+            return 0
+        finally:
+            client.close(True)
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ import time as _time
 from collections import deque
 
 from util.memory import release_freed_memory
+from util.sockets import accept_client
 
 from .clock import MoosClock
 from .codec import (
@@ -241,16 +242,12 @@ class MoosDB:
         log.info("MOOSDB %s on port %d stopped", self.community, self.port)
 
     def _accept(self) -> None:
-        try:
-            sock, addr = self._listener.accept()  # type: ignore[union-attr]
-        except (BlockingIOError, InterruptedError):
+        assert self._listener is not None
+        accepted = accept_client(self._listener)
+        if accepted is None:
             return
-        except OSError as exc:
-            log.warning("accept failed: %s", exc)
-            return
-        sock.setblocking(False)
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        client = _Client(sock, f"{addr[0]}:{addr[1]}", self.max_packet_bytes)
+        sock, peer = accepted
+        client = _Client(sock, peer, self.max_packet_bytes)
         self._clients[sock.fileno()] = client
         self._set_events(client)
         log.debug("accepted a connection from %s", client.peer)

@@ -15,14 +15,13 @@ import shlex
 import signal
 import sys
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import parse_file
 from launch.process_group import ProcessGroup, child_environment
 from util.logsetup import add_verbosity_argument, configure_logging
+from util.process import handle_signals
 
 log = logging.getLogger(__name__)
 
@@ -71,22 +70,6 @@ def default_log_dir(platform: str, environ: dict[str, str] | os._Environ[str]) -
     return f"/tmp/goby_launch_{platform}_{time.strftime('%Y%m%dT%H%M%S', time.gmtime())}"
 
 
-@contextmanager
-def stop_on_signals(group: ProcessGroup) -> Iterator[None]:
-    """SIGINT and SIGTERM set the group's stop event; the previous handlers come back afterwards."""
-
-    def handler(signum: int, _frame: object) -> None:
-        group.report(f"\nReceived {signal.Signals(signum).name}")
-        group.stop_event.set()
-
-    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, old in previous.items():
-            signal.signal(sig, old)
-
-
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     configure_logging(args.verbose, "goby-launch")
@@ -121,7 +104,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"Sourcing {preseed} before each command", flush=True)
     group.preamble = preamble
     print(f"Logs in {log_dir}", flush=True)
-    with stop_on_signals(group):
+    def on_signal(signum: int) -> None:
+        group.report(f"\nReceived {signal.Signals(signum).name}")
+        group.stop_event.set()
+
+    with handle_signals(on_signal):
         try:
             group.start()
         except ProcessDiedError as exc:

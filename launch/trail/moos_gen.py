@@ -8,7 +8,6 @@ files must not outlive the mission. The MOOS lines of the launch file generate t
 
 from __future__ import annotations
 
-import signal
 import sys
 import threading
 
@@ -16,18 +15,21 @@ from launch.config import fail
 from launch.errors import MissionConfigError
 from launch.trail.config import write_moos_files
 from launch.trail.settings import TrailSettings, vehicle_from_env
+from util.process import handle_signals
 
 
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
     if len(args) != 1 or args[0] not in ("usv", "auv"):
         return fail("usage: python -m launch.trail.moos_gen usv|auv")
-    stop = threading.Event()
-    for sig in (signal.SIGTERM, signal.SIGINT):
-        signal.signal(sig, lambda *_: stop.set())
+    with handle_signals() as stop:
+        return _write_and_wait(args[0], stop)
+
+
+def _write_and_wait(vehicle: str, stop: threading.Event) -> int:
     try:
         settings = TrailSettings.from_env()
-        paths = write_moos_files(settings, vehicle_from_env(args[0]))
+        paths = write_moos_files(settings, vehicle_from_env(vehicle))
     except MissionConfigError as exc:
         return fail(str(exc))
     print("wrote " + " and ".join(str(p) for p in paths), flush=True)

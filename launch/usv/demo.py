@@ -11,11 +11,11 @@ stopped cleanly.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import math
 import shlex
 import shutil
-import signal
 import socket
 import sys
 import tempfile
@@ -23,7 +23,6 @@ import time
 from pathlib import Path
 
 from gateway.goby.acomms.udp_multicast import random_multicast
-from launch.config import free_tcp_port
 from launch.errors import LaunchError, MissionConfigError
 from launch.usv.analysis import bhv_waypoints, command_effects, loiter_phases, transitions
 from launch.usv.mission import MissionResult, UsvMission, choose_program
@@ -32,6 +31,7 @@ from launch.usv.settings import DEFAULT_SCHEDULE, KAUAI_ORIGIN, UsvSettings
 from launch.usv.shore import SCHEDULE_HELP, parse_schedule
 from launch.usv.summary import progress_line, summary_text
 from util.logsetup import add_verbosity_argument, configure_logging
+from util.process import free_port, handle_signals
 
 log = logging.getLogger(__name__)
 
@@ -110,7 +110,7 @@ def _port(requested: int, preferred: int) -> int:
             sock.bind(("127.0.0.1", preferred))
         return preferred
     except OSError:
-        return free_tcp_port()
+        return free_port()
 
 
 def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> UsvSettings:
@@ -197,7 +197,8 @@ def run_demo(args: argparse.Namespace) -> int:
     print(f"shore schedule: {settings.schedule}" + ("" if planned else " (no commands: send them from the "
                                                       "commander page or with usv-command)"), flush=True)
     mission = UsvMission(settings)
-    previous = {s: signal.signal(s, lambda *_: mission.stop_event.set()) for s in (signal.SIGINT, signal.SIGTERM)}
+    signals = contextlib.ExitStack()  # SIGINT/SIGTERM stop the mission; the previous handlers come back in `finally`
+    signals.enter_context(handle_signals(lambda _signum: mission.stop_event.set()))
     failure = None
     started = time.monotonic()
     try:
@@ -220,8 +221,7 @@ def run_demo(args: argparse.Namespace) -> int:
         print(f"demo: {exc}", file=sys.stderr, flush=True)
     finally:
         result = mission.stop(failure)
-        for s, handler in previous.items():
-            signal.signal(s, handler)
+        signals.close()
         if socket_dir != run_dir:
             shutil.rmtree(socket_dir, ignore_errors=True)
     out.mkdir(parents=True, exist_ok=True)

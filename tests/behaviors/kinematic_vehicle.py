@@ -1,17 +1,18 @@
 """Test double for a vehicle simulator (uSimMarine's job): a kinematic model that follows DESIRED_*.
 
-``KinematicModel`` is the pure model; ``KinematicVehicle`` runs it as a MOOS client on its own thread,
+``KinematicModel`` holds the state and moves it with the basic frontseat simulator's own dynamics
+(``frontseat.simulator.model.step_dynamics``); ``KinematicVehicle`` runs it as a MOOS client on its own thread,
 subscribing DESIRED_HEADING/SPEED/DEPTH and posting NAV_X/Y/HEADING/SPEED/DEPTH. It is a stand-in for
 the real frontseat simulator path, which the launcher tests exercise end to end.
 """
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 from dataclasses import dataclass, field
 
+from frontseat.simulator.model import Kinematics, VehicleConfig, step_dynamics
 from gateway.moos import MoosClock, comms
 
 
@@ -33,16 +34,13 @@ class KinematicModel:
     track: list[tuple[float, float, float, float, float]] = field(default_factory=list)
 
     def step(self, dt: float, t: float) -> None:
-        error = (self.desired_heading - self.heading + 180.0) % 360.0 - 180.0
-        turn = max(-self.turn_rate * dt, min(self.turn_rate * dt, error))
-        self.heading = (self.heading + turn) % 360.0
-        dv = max(-self.accel * dt, min(self.accel * dt, self.desired_speed - self.speed))
-        self.speed = max(0.0, self.speed + dv)
-        dz = max(-self.z_rate * dt, min(self.z_rate * dt, self.desired_depth - self.depth))
-        self.depth += dz
-        rad = math.radians(self.heading)
-        self.x += self.speed * math.sin(rad) * dt
-        self.y += self.speed * math.cos(rad) * dt
+        """One step of the frontseat simulator's dynamics (``step_dynamics``) with this model's rate limits."""
+        vehicle = Kinematics(x=self.x, y=self.y, z=-self.depth, v=self.speed, hdg=self.heading)
+        desired = Kinematics(z=-self.desired_depth, v=self.desired_speed, hdg=self.desired_heading)
+        step_dynamics(vehicle, desired, VehicleConfig(accel=self.accel, hdg_rate=self.turn_rate, z_rate=self.z_rate),
+                      dt)
+        self.x, self.y, self.depth, self.speed = vehicle.x, vehicle.y, -vehicle.z, max(0.0, vehicle.v)
+        self.heading = vehicle.hdg % 360.0
         self.track.append((t, self.x, self.y, self.heading, self.speed))
 
 

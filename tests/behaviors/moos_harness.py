@@ -13,6 +13,7 @@ import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+from behaviors.testing import write_helm_mission
 from gateway.moos import MoosClock, comms
 from util.process import ChildProcess
 
@@ -22,34 +23,12 @@ WARP = 20.0
 REPO = Path(__file__).resolve().parents[2]
 IVP_HELM = Path(sys.executable).parent / "ivp-helm"
 
-MISSION = """\
-ServerHost = 127.0.0.1
-ServerPort = {port}
-Community  = {community}
-MOOSTimeWarp = {warp}
-LatOrigin  = 43.825300
-LongOrigin = -70.330400
-
-ProcessConfig = pHelmIvP
-{{
-  AppTick    = {app_tick}
-  CommsTick  = 4
-  bhv_dir_not_found_ok = true
-  behaviors  = {bhv}
-  domain     = course:0:359:360
-  domain     = speed:0:{max_speed}:41
-{extra}}}
-{blocks}"""
-
-
 def write_mission(tmp_path: Path, port: int, bhv: Path, warp: float = WARP, community: str = "alpha",
                   max_speed: str = "2", extra: str = "", app_tick: float = 4, blocks: str = "",
                   name: str = "mission.moos") -> Path:
-    """The mission file: ``extra`` lines go into the pHelmIvP block, ``blocks`` (other ProcessConfigs) after it."""
-    path = tmp_path / name
-    path.write_text(MISSION.format(port=port, warp=warp, bhv=bhv, community=community, max_speed=max_speed,
-                                   extra=extra, app_tick=f"{app_tick:g}", blocks=blocks))
-    return path
+    """The mission file at this harness's warp: see :func:`behaviors.testing.write_helm_mission`."""
+    return write_helm_mission(tmp_path, port, bhv, warp=warp, community=community, max_speed=max_speed, extra=extra,
+                              app_tick=app_tick, blocks=blocks, name=name)
 
 
 class Observer:

@@ -8,11 +8,12 @@ import signal
 import subprocess
 import sys
 import textwrap
-import threading
 import time
 from pathlib import Path
 
 import pytest
+
+from util.process import ChildProcess, wait_until
 
 # A child that records the signal it got in its log, so the test can see the shutdown order.
 CHILD = textwrap.dedent(
@@ -31,49 +32,18 @@ CHILD = textwrap.dedent(
 )
 
 
-class LauncherRun:
-    """goby-launch in a child process, its output collected by a reader thread (joined in finish())."""
-
-    def __init__(self, launch_file: Path, log_dir: Path, *extra: str) -> None:
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "launch.apps.goby_launch", "-d", "50", "--status-period", "0.5", "-L", str(log_dir),
-             *extra, str(launch_file)],
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
-        self.lines: list[str] = []
-        self.reader = threading.Thread(target=self._read, name="launcher-output", daemon=True)
-        self.reader.start()
-
-    def _read(self) -> None:
-        for line in self.proc.stdout:
-            self.lines.append(line)
-
-    @property
-    def output(self) -> str:
-        return "".join(self.lines)
-
-    def wait_for_output(self, text: str, timeout: float = 60.0) -> None:
-        _wait_for(lambda: text in self.output, timeout, what=repr(text))
-
-    def finish(self, timeout: float = 60.0) -> str:
-        try:
-            self.proc.wait(timeout=timeout)
-        finally:
-            if self.proc.poll() is None:
-                self.proc.kill()
-                self.proc.wait()
-            self.reader.join(timeout=10)
-        return self.output
+def start_launcher(launch_file: Path, log_dir: Path, *extra: str) -> ChildProcess:
+    """goby-launch as a child process, its output in ``goby-launch.out`` next to ``log_dir``."""
+    return ChildProcess([sys.executable, "-m", "launch.apps.goby_launch", "-d", "50", "--status-period", "0.5",
+                         "-L", str(log_dir), *extra, str(launch_file)], log_dir.parent / "goby-launch.out").start()
 
 
-def _wait_for(predicate, timeout: float = 60.0, what: str = "condition") -> None:
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.05)
+def finish(run: ChildProcess, timeout: float = 60.0) -> str:
+    """Wait for the launcher to end by itself (SIGKILL after ``timeout``); its output."""
+    if run.wait(timeout) is None:
+        run.kill()
+    run.stop()
+    return run.output()
 
 
 def _pid_alive(pid: int) -> bool:
@@ -109,15 +79,15 @@ def test_starts_in_order_and_stops_in_reverse_on_sigint(tmp_path, child_script):
         f"[name=third, kill=SIGINT] {sys.executable} {child_script} third\n"
     )
     logs = tmp_path / "logs"
-    run = LauncherRun(launch_file, logs)
+    run = start_launcher(launch_file, logs)
     try:
-        run.wait_for_output("All processes running (3): first, second, third")
-        _wait_for(lambda: all("up" in (logs / f"{n}.log").read_text() for n in ("first", "second", "third")),
-                  what="all three children up")
-        run.proc.send_signal(signal.SIGINT)
+        run.wait_ready(re.escape("All processes running (3): first, second, third"), timeout=60)
+        wait_until(lambda: all("up" in (logs / f"{n}.log").read_text() for n in ("first", "second", "third")), 60,
+                  "all three children up")
+        run.send_signal(signal.SIGINT)
     finally:
-        output = run.finish()
-    assert run.proc.returncode == 0, output
+        output = finish(run)
+    assert run.returncode == 0, output
     second_log = (logs / "second.log").read_text()
     assert "hello" in second_log and "substituted" in second_log
     stamps = {}
@@ -136,9 +106,9 @@ def test_a_dying_process_is_named_with_its_log_tail_and_the_rest_are_stopped(tmp
         f"[name=doomed] bash -c 'sleep 2; echo boom: cannot reach the MOOSDB >&2; exit 3'\n"
     )
     logs = tmp_path / "logs"
-    run = LauncherRun(launch_file, logs)
-    output = run.finish()
-    assert run.proc.returncode == 1, output
+    run = start_launcher(launch_file, logs)
+    output = finish(run)
+    assert run.returncode == 1, output
     assert "doomed died unexpectedly (exit status 3)" in output
     assert "boom: cannot reach the MOOSDB" in output
     assert "survivor got SIGTERM" in (logs / "survivor.log").read_text()
@@ -151,9 +121,9 @@ def test_death_during_startup_fails_the_launch(tmp_path, child_script):
         f"[name=ok] {sys.executable} {child_script} ok\n"
         "[name=missing] no-such-program-xyz --flag\n"
     )
-    run = LauncherRun(launch_file, tmp_path / "logs")
-    output = run.finish()
-    assert run.proc.returncode == 1
+    run = start_launcher(launch_file, tmp_path / "logs")
+    output = finish(run)
+    assert run.returncode == 1
     assert "failed to launch" in output and "'missing'" in output
     assert "no-such-program-xyz" in output  # bash's "not found" from the log tail
     assert all(not _pid_alive(pid) for pid in _launched_pids(output))
@@ -163,13 +133,13 @@ def test_sigkill_after_the_kill_timeout(tmp_path):
     launch_file = tmp_path / "stubborn.launch"
     launch_file.write_text("[name=stubborn] bash -c 'trap \"echo ignoring TERM\" TERM; while true; do sleep 0.1; done'\n")
     logs = tmp_path / "logs"
-    run = LauncherRun(launch_file, logs, "-k", "1")
+    run = start_launcher(launch_file, logs, "-k", "1")
     try:
-        run.wait_for_output("All processes running")
+        run.wait_ready(re.escape("All processes running"), timeout=60)
         started = time.monotonic()
-        run.proc.send_signal(signal.SIGTERM)
+        run.send_signal(signal.SIGTERM)
     finally:
-        output = run.finish()
+        output = finish(run)
     assert "did not respond to SIGTERM after 1 s, sending SIGKILL" in output
     assert time.monotonic() - started >= 1.0
     assert "ignoring TERM" in (logs / "stubborn.log").read_text()
@@ -195,9 +165,9 @@ def test_bad_launch_files_and_options_exit_non_zero_with_the_cause(tmp_path, con
 def test_a_process_that_finishes_with_status_zero_is_not_a_failure(tmp_path):
     launch_file = tmp_path / "oneshot.launch"
     launch_file.write_text("[name=oneshot] bash -c 'sleep 1.5; echo done'\n")
-    run = LauncherRun(launch_file, tmp_path / "logs")
-    output = run.finish()
-    assert run.proc.returncode == 0, output
+    run = start_launcher(launch_file, tmp_path / "logs")
+    output = finish(run)
+    assert run.returncode == 0, output
     assert "oneshot finished" in output
     assert "All processes exited" in output
 
@@ -207,9 +177,9 @@ def test_preseed_next_to_the_launch_file_is_sourced_for_every_command(tmp_path):
     launch_file = tmp_path / "seeded.launch"
     launch_file.write_text("[name=one] bash -c 'echo one=$FROM_PRESEED'\n[name=two] bash -c 'echo two=$FROM_PRESEED'\n")
     logs = tmp_path / "logs"
-    run = LauncherRun(launch_file, logs)
-    output = run.finish()
-    assert run.proc.returncode == 0, output
+    run = start_launcher(launch_file, logs)
+    output = finish(run)
+    assert run.returncode == 0, output
     assert "Sourcing" in output
     assert "one=seeded" in (logs / "one.log").read_text()
     assert "two=seeded" in (logs / "two.log").read_text()

@@ -10,52 +10,30 @@ import signal
 import subprocess
 import sys
 import tempfile
-import threading
-import time
 import urllib.request
 from pathlib import Path
 
 import pytest
 
 from gateway.goby.intervehicle.testing import random_multicast
-from launch.config import free_tcp_port
 from launch.process_group import child_environment
 from launch.usv.mission import LAUNCH_FILE
 from launch.usv.settings import UsvSettings
+from util.process import ChildProcess, free_port, wait_until
 
 
-class OutputReader:
-    """Collects a child's stdout on a thread (joined by ``finish``)."""
+def expect(run: ChildProcess, pattern: str, timeout: float = 90.0) -> re.Match[str]:
+    """The first match of ``pattern`` in the run's output; fails with the output so far if it never comes."""
+    match = run.wait_for_output(pattern, timeout)
+    assert match is not None, f"never saw {pattern!r}; output so far:\n{run.output()}"
+    return match
 
-    def __init__(self, proc: subprocess.Popen[str]) -> None:
-        self.proc = proc
-        self.lines: list[str] = []
-        self.thread = threading.Thread(target=lambda: self.lines.extend(proc.stdout), name="cli-output", daemon=True)
-        self.thread.start()
 
-    @property
-    def text(self) -> str:
-        return "".join(self.lines)
-
-    def wait_for(self, pattern: str, timeout: float = 90.0) -> re.Match[str]:
-        deadline = time.monotonic() + timeout
-        while True:
-            match = re.search(pattern, self.text, flags=re.M)
-            if match:
-                return match
-            if self.proc.poll() is not None or time.monotonic() > deadline:
-                raise AssertionError(f"never saw {pattern!r}; output so far:\n{self.text}")
-            time.sleep(0.1)
-
-    def finish(self, timeout: float = 90.0) -> str:
-        try:
-            self.proc.wait(timeout=timeout)
-        finally:
-            if self.proc.poll() is None:
-                self.proc.kill()
-                self.proc.wait()
-            self.thread.join(timeout=10)
-        return self.text
+def finish(run: ChildProcess, timeout: float = 90.0) -> str:
+    """Wait for the run to end by itself (stopped after ``timeout``); its output."""
+    run.wait(timeout)
+    run.stop()
+    return run.output()
 
 
 def _alive(pid: int) -> bool:
@@ -68,29 +46,25 @@ def _alive(pid: int) -> bool:
 
 def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_path):
     socket_dir = Path(tempfile.mkdtemp(prefix="usvl-", dir="/tmp"))
-    settings = UsvSettings(run_dir=tmp_path / "run", warp=10, moos_port=free_tcp_port(), sim_port=free_tcp_port(),
-                           liaison_port=free_tcp_port(), moosdb="moos-db", helm="ivp-helm",
+    settings = UsvSettings(run_dir=tmp_path / "run", warp=10, moos_port=free_port(), sim_port=free_port(),
+                           liaison_port=free_port(), moosdb="moos-db", helm="ivp-helm",
                            socket_name=str(socket_dir / "goby_usv"), sat_port=random_multicast()[1])
     env = child_environment() | settings.to_env()
-    proc = subprocess.Popen(
+    proc = ChildProcess(
         [sys.executable, "-m", "launch.apps.goby_launch", "-d", "200", "--status-period", "1", "-L", str(tmp_path / "logs"),
          str(LAUNCH_FILE)],
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env,
-    )
-    out = OutputReader(proc)
+        tmp_path / "run.out", env=env,
+    ).start()
     try:
-        out.wait_for(r"All processes running \(11\)")
-        helm_pid = int(out.wait_for(r"^Launched \((\d+)\) usv\.helm:").group(1))
+        expect(proc, r"All processes running \(11\)")
+        helm_pid = int(expect(proc, r"^Launched \((\d+)\) usv\.helm:").group(1))
         moosdb_log = tmp_path / "logs" / "usv.moosdb.log"
-        deadline = time.monotonic() + 60  # ten Python processes starting at once: the DB may still be importing
-        while "listening" not in (moosdb_log.read_text() if moosdb_log.exists() else "") and time.monotonic() < deadline:
-            time.sleep(0.1)
+        # ten Python processes starting at once: the DB may still be importing
+        wait_until(lambda: moosdb_log.exists() and "listening" in moosdb_log.read_text(), 60, "the MOOSDB listening")
         os.kill(helm_pid, signal.SIGKILL)
-        text = out.finish()
+        text = finish(proc)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-        out.finish()
+        proc.stop()
         shutil.rmtree(socket_dir, ignore_errors=True)
     assert proc.returncode == 1, text
     assert "usv.helm died unexpectedly (exit status -9)" in text
@@ -104,21 +78,18 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
 
 def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(tmp_path):
     out_dir = tmp_path / "o"
-    proc = subprocess.Popen(
+    proc = ChildProcess(
         [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--forever", "--warp", "20",
-         "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_tcp_port()),
-         "--sim-port", str(free_tcp_port()), "--liaison-port", str(free_tcp_port())],
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-    )
-    out = OutputReader(proc)
+         "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_port()),
+         "--sim-port", str(free_port()), "--liaison-port", str(free_port())],
+        tmp_path / "run.out",
+    ).start()
     try:
-        out.wait_for(r"^t=\s*(1\d\d|[2-9]\d\d) s sim \| interface INTERFACE_COMMAND \| helm DRIVE")
+        expect(proc, r"^t=\s*(1\d\d|[2-9]\d\d) s sim \| interface INTERFACE_COMMAND \| helm DRIVE")
         proc.send_signal(signal.SIGINT)
-        text = out.finish()
+        text = finish(proc)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-        out.finish()
+        proc.stop()
     assert proc.returncode == 0, text
     assert "=== USV mission summary" in text
     assert "processes: 11/11 exited cleanly" in text
@@ -131,22 +102,19 @@ def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(
 
 
 def test_demo_names_a_component_that_dies_and_exits_non_zero(tmp_path):
-    proc = subprocess.Popen(
+    proc = ChildProcess(
         [sys.executable, "-m", "launch.usv.demo", "--out", str(tmp_path / "o"), "--duration", "0", "--warp", "20",
-         "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_tcp_port()),
-         "--sim-port", str(free_tcp_port()), "--liaison-port", str(free_tcp_port())],
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-    )
-    out = OutputReader(proc)
+         "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_port()),
+         "--sim-port", str(free_port()), "--liaison-port", str(free_port())],
+        tmp_path / "run.out",
+    ).start()
     try:
-        sim_pid = int(out.wait_for(r"^Launched \((\d+)\) usv\.frontseat-sim:").group(1))
-        out.wait_for(r"^t=\s*\d+/?\S* s sim \| interface INTERFACE_COMMAND")
+        sim_pid = int(expect(proc, r"^Launched \((\d+)\) usv\.frontseat-sim:").group(1))
+        expect(proc, r"^t=\s*\d+/?\S* s sim \| interface INTERFACE_COMMAND")
         os.kill(sim_pid, signal.SIGKILL)
-        text = out.finish()
+        text = finish(proc)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-        out.finish()
+        proc.stop()
     assert proc.returncode == 1, text
     assert "process 'usv.frontseat-sim' died (exit status -9)" in text
     assert "FAILED: process 'usv.frontseat-sim' died" in text  # the summary says so too
@@ -169,8 +137,8 @@ def test_demo_names_a_component_that_dies_and_exits_non_zero(tmp_path):
 def test_demo_refuses_bad_arguments_before_starting_anything(tmp_path, args, message):
     out_dir = tmp_path / "o"
     proc = subprocess.run(
-        [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--moos-port", str(free_tcp_port()),
-         "--sim-port", str(free_tcp_port()), *args],
+        [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--moos-port", str(free_port()),
+         "--sim-port", str(free_port()), *args],
         capture_output=True, text=True, timeout=60,
     )
     assert proc.returncode == 2, proc.stdout + proc.stderr
@@ -181,32 +149,29 @@ def test_demo_refuses_bad_arguments_before_starting_anything(tmp_path, args, mes
 
 def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(tmp_path):
     out_dir = tmp_path / "o"
-    proc = subprocess.Popen(
+    proc = ChildProcess(
         [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--forever", "--warp", "20",
-         "--schedule", "none", "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_tcp_port()),
-         "--sim-port", str(free_tcp_port()), "--liaison-port", str(free_tcp_port())],
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-    )
-    out = OutputReader(proc)
+         "--schedule", "none", "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_port()),
+         "--sim-port", str(free_port()), "--liaison-port", str(free_port())],
+        tmp_path / "run.out",
+    ).start()
     sent: subprocess.CompletedProcess[str] | None = None
     try:
-        commander = out.wait_for(r"Command it from the browser: (http://127\.0\.0\.1:\d+/\?_=/commander)\n")
+        commander = expect(proc, r"Command it from the browser: (http://127\.0\.0\.1:\d+/\?_=/commander)\n")
         assert urllib.request.urlopen(commander.group(1), timeout=10).status == 200  # the page is served
-        block = out.wait_for(r"or, in another terminal \(bash\):\n"
+        block = expect(proc, r"or, in another terminal \(bash\):\n"
                              r"  (export .*)\n  (.* waypoints .*)\n  (.* polygon .*)\n")
         export, waypoints = block.group(1), block.group(2)
-        out.wait_for(r"^t=\s*\d+ s sim \| interface INTERFACE_COMMAND \| helm DRIVE")
+        expect(proc, r"^t=\s*\d+ s sim \| interface INTERFACE_COMMAND \| helm DRIVE")
         # The user's other terminal: none of the run's USV_* variables, another directory, the printed lines only.
         user_env = {k: v for k, v in os.environ.items() if not k.startswith("USV_")}
         sent = subprocess.run(["bash", "-c", f"{export}\n{waypoints}"], cwd=tmp_path, env=user_env,
                               capture_output=True, text=True, timeout=90)
-        out.wait_for(r"^t=\s*\d+ s sim \| .*\| DEPLOY_STATE WAYPOINTS \|")
+        expect(proc, r"^t=\s*\d+ s sim \| .*\| DEPLOY_STATE WAYPOINTS \|")
         proc.send_signal(signal.SIGINT)
-        text = out.finish()
+        text = finish(proc)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-        out.finish()
+        proc.stop()
     assert sent is not None
     assert sent.returncode == 0, sent.stdout + sent.stderr
     assert "acked over the satellite link by satellite modem 2" in sent.stdout, sent.stdout + sent.stderr

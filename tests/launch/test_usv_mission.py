@@ -16,7 +16,6 @@ from gateway.goby.intervehicle.testing import random_multicast
 from gateway.goby.portal.interface_registry import ENV_VAR as REGISTRY_ENV
 from gateway.goby.portal.interface_registry import read_entries
 from gateway.moos.testing import real_moos_skip_reason
-from launch.config import free_tcp_port
 from launch.interfaces.deployment import DEFAULT_INTERFACES_DIR
 from launch.interfaces.drift import covered_threads, drift_problems
 from launch.interfaces.interface_yaml import load as load_interface
@@ -32,6 +31,7 @@ from launch.usv.analysis import (
 from launch.usv.mission import MissionResult, UsvMission
 from launch.usv.settings import UsvSettings
 from launch.usv.summary import summary_text
+from util.process import free_port
 
 WARP = 30
 DURATION_S = 1150.0
@@ -45,9 +45,9 @@ def run_mission(run_dir: Path, moosdb: str, helm: str) -> MissionResult:
     settings = UsvSettings(
         run_dir=run_dir,
         warp=WARP,
-        moos_port=free_tcp_port(),
-        sim_port=free_tcp_port(),
-        liaison_port=free_tcp_port(),
+        moos_port=free_port(),
+        sim_port=free_port(),
+        liaison_port=free_port(),
         moosdb=moosdb,
         helm=helm,
         schedule=SCHEDULE,

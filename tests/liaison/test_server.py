@@ -12,13 +12,13 @@ import pytest
 from google.protobuf import text_format
 
 from gateway.goby.portal.testing import PortalClient, broker_process, running_app
-from launch.config import free_tcp_port
 from launch.liaison.portal_side import LiaisonApp
 from launch.liaison.protobuf import liaison_web_pb2  # noqa: F401 - the [..web] extension
 from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
 from translators.usv import groups as usv_groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
+from util.process import free_port
 
 CONFIG = """
 http_address: "127.0.0.1"
@@ -43,7 +43,7 @@ pb_commander_config {{
 @pytest.fixture
 def liaison(tmp_path):
     with broker_process(tmp_path, platform="web") as broker:
-        cfg = text_format.Parse(CONFIG.format(port=free_tcp_port()), LiaisonConfig())
+        cfg = text_format.Parse(CONFIG.format(port=free_port()), LiaisonConfig())
         cfg.interprocess.CopyFrom(broker.interprocess_config())
         with running_app(LiaisonApp, cfg) as app, PortalClient(broker.interprocess_config()) as client:
             client.wait_subscribed()

@@ -13,7 +13,7 @@ from gateway.apps import moos_poke as poke
 from gateway.apps import moos_scope as scope
 from gateway.apps.moos_tool_args import adopt_db_time_warp
 from gateway.moos.testing import MoosDBProcess, collect_mail, connected_comms, running_moosdb
-from util.process import free_port
+from util.process import ChildProcess, free_port
 
 BIN = Path(sys.executable).parent
 
@@ -35,16 +35,12 @@ def test_moos_db_console_script_uses_the_mission_file(tmp_path: Path) -> None:
     port = free_port()
     mission = tmp_path / "m.moos"
     mission.write_text(f"ServerPort = {port}\nCommunity = fromfile\n")
-    proc = subprocess.Popen([str(BIN / "moos-db"), str(mission)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            cwd=tmp_path)
-    try:
-        line = proc.stdout.readline().decode()  # type: ignore[union-attr]
-        assert line.strip() == f"MOOSDB fromfile listening on 127.0.0.1:{port}"
+    with ChildProcess([str(BIN / "moos-db"), str(mission)], tmp_path / "moos-db.out", cwd=tmp_path,
+                      stderr_path=tmp_path / "moos-db.log") as proc:
+        ready = proc.wait_ready(r"^MOOSDB .*$", timeout=30)
+        assert ready is not None and ready.group(0) == f"MOOSDB fromfile listening on 127.0.0.1:{port}"
         with connected_comms(port, "probe") as probe:
             assert probe.get_community_name() == "fromfile"
-    finally:
-        proc.terminate()
-        proc.communicate(timeout=10)
     assert proc.returncode == 0
 
 

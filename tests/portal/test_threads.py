@@ -24,17 +24,9 @@ from gateway.goby.portal import (
 from gateway.goby.portal.interface_registry import ENV_VAR, read_entries
 from gateway.goby.portal.testing import BrokerProcess, PortalClient, app_process, running_app
 from tests.protobuf.sample_messages_pb2 import Sample, SampleAppConfig
+from util.process import wait_until
 
 REPO = Path(__file__).resolve().parents[2]
-
-
-def wait_until(predicate: Any, timeout_s: float = 20.0) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 class Worker(SimpleThread):
@@ -71,7 +63,7 @@ def test_call_soon_runs_on_owning_thread_and_wakes_it() -> None:
         assert elapsed < 1.0  # the thread has no loop: only the wake-up can have run it
         worker.call_soon(lambda: 1 / 0)  # logged, the thread keeps serving
         worker.call_soon(done.clear)
-        assert wait_until(lambda: not done.is_set())
+        wait_until(lambda: not done.is_set(), 20, "not done.is_set()")
         assert app.join_thread(Worker) == 1
 
 
@@ -81,7 +73,7 @@ def test_interthread_delivers_on_subscriber_threads_without_echo() -> None:
         w2 = app.launch_thread(Worker, SampleAppConfig())
         for a in range(1, 4):
             w1.call_soon(lambda a=a: w1.interthread().publish("work", Sample(a=a)))
-        assert wait_until(lambda: len(w2.seen) == 3)
+        wait_until(lambda: len(w2.seen) == 3, 20, "len(w2.seen) == 3")
         time.sleep(0.1)
         assert [a for a, _ in w2.seen] == [1, 2, 3]
         assert {t for _, t in w2.seen} == {w2.ident}
@@ -106,7 +98,7 @@ def test_interthread_regex_subscription() -> None:
             tx.call_soon(lambda g=group: tx.interthread().publish(g, Sample(a=1)))
         tx.call_soon(lambda: tx.interthread().publish("other", "a string"))
         tx.call_soon(lambda: tx.interthread().publish("other", Sample(a=2)))
-        assert wait_until(lambda: len(rx.hits) == 3)
+        wait_until(lambda: len(rx.hits) == 3, 20, "len(rx.hits) == 3")
         time.sleep(0.1)
     assert rx.hits == [("work", "goby.test.zeromq.protobuf.Sample", 5), ("other", "goby.test.zeromq.protobuf.Sample", 5),
                        ("other", "goby.test.zeromq.protobuf.Sample", 5)]
@@ -130,7 +122,7 @@ def test_launch_errors_and_loop_errors() -> None:
         with pytest.raises(ThreadError, match="Broken failed to start: no hardware"):
             app.launch_thread(Broken)
         app.launch_thread(LoopFails)
-        assert wait_until(lambda: app.return_code == 1 and not app.alive)
+        wait_until(lambda: app.return_code == 1 and not app.alive, 20, "app.return_code == 1 and not app.alive")
 
 
 class Ticker(SingleThreadApplication):
@@ -178,7 +170,7 @@ def test_non_main_thread_uses_interprocess_with_callbacks_on_its_thread(broker: 
     with running_app(PortalApp, cfg) as app, PortalClient(broker.interprocess_config(), "pt_client") as client:
         answers = client.collect("from_thread", Sample)
         assert client.wait_subscribed()
-        assert wait_until(lambda: not app.interprocess().hold_state())
+        wait_until(lambda: not app.interprocess().hold_state(), 20, "not app.interprocess().hold_state()")
         a = 0
 
         def answered() -> bool:

@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 from translator_procs import ORIGIN, run_cli, start_child
 
+from behaviors.testing import write_helm_mission
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import USV, DesiredCourse, NodeStatus
 from frontseat.protobuf.frontseat_pb2 import HELM_DRIVE, HelmStateReport
@@ -51,25 +52,6 @@ Behavior = BHV_Loiter
 }
 """
 
-MOOS = """
-ServerHost = 127.0.0.1
-ServerPort = %(port)d
-Community  = usv
-MOOSTimeWarp = 1
-LatOrigin  = %(lat)s
-LongOrigin = %(lon)s
-
-ProcessConfig = pHelmIvP
-{
-  AppTick   = 4
-  CommsTick = 4
-  behaviors = %(bhv)s
-  domain    = course:0:359:360
-  domain    = speed:0:2:41
-}
-"""
-
-
 def helm_command(kind: str, mission: Path) -> list[str]:
     if kind == "pHelmIvP":
         if shutil.which("pHelmIvP") is None:
@@ -91,8 +73,7 @@ def nav_at_origin() -> NodeStatus:
 def test_helm_drives_through_the_gateway_and_a_shore_command_switches_its_behaviour(stack, tmp_path, helm_kind):
     bhv = tmp_path / "usv.bhv"
     bhv.write_text(BHV % {"waypoint_speed": WAYPOINT_SPEED, "loiter_speed": LOITER_SPEED})
-    mission = tmp_path / "usv.moos"
-    mission.write_text(MOOS % {"port": stack.moos_port, "lat": ORIGIN[0], "lon": ORIGIN[1], "bhv": bhv})
+    mission = write_helm_mission(tmp_path, stack.moos_port, bhv, community="usv", origin=ORIGIN, name="usv.moos")
     helm = start_child(helm_kind, helm_command(helm_kind, mission), tmp_path)
     try:
         with PortalClient(stack.broker.interprocess_config(), name="frontseat_stand_in") as client, \

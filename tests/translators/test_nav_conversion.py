@@ -9,19 +9,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus, Source
+from tests.geodesy_reference import ORIGIN, REFERENCE
 from translators.frontseat.nav_conversion import format_g15, nav_posts, node_report
 from translators.node_report_codec import course_number
 from util.geodesy import UTMGeodesy
 
-# ivp_helm.md §7.3: origin 43.8253, -70.3304 (zone 19T); (x, y) <-> (lat, lon) from pyproj/PROJ and a Gantz port.
-ORIGIN = (43.8253, -70.3304)
-REFERENCE = [
-    ((0.0, -20.0), (43.82511997, -70.33039600)),
-    ((60.0, -40.0), (43.82494863, -70.32964602)),
-    ((180.0, -100.0), (43.82442590, -70.32814209)),
-    ((100.0, 100.0), (43.82621460, -70.32917667)),
-    ((1000.0, -1000.0), (43.81644267, -70.31776886)),
-]
 TOLERANCE_M = 0.005  # the reference lat/lon carry 8 decimals, about 1 mm
 
 

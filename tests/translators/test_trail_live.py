@@ -9,6 +9,7 @@ import time
 import pytest
 from translator_procs import ORIGIN, start_child
 
+from behaviors.testing import write_helm_mission
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import USV, NodeStatus
 from gateway.goby.portal.testing import PortalClient, broker_process
@@ -36,25 +37,6 @@ Behavior = BHV_Trail
 }
 """
 
-MOOS = """
-ServerHost = 127.0.0.1
-ServerPort = %(port)d
-Community  = auv0
-MOOSTimeWarp = 1
-LatOrigin  = %(lat)s
-LongOrigin = %(lon)s
-
-ProcessConfig = pHelmIvP
-{
-  AppTick   = 4
-  CommsTick = 4
-  behaviors = %(bhv)s
-  domain    = course:0:359:360
-  domain    = speed:0:4:41
-}
-"""
-
-
 def usv_status(geodesy: UTMGeodesy, x: float, y: float, heading: float) -> NodeStatus:
     status = NodeStatus(time=time.time(), name="USV", type=USV)
     status.global_fix.lat, status.global_fix.lon = geodesy.to_geo(x, y)
@@ -72,8 +54,8 @@ def test_real_phelmivp_trails_a_contact_known_only_from_our_node_report(tmp_path
     with running_moosdb(community="auv0") as db, broker_process(tmp_path, platform="auv0") as broker:
         cfg = gateway_config(db.port, broker.interprocess_config())
         cfg.app.geodesy.lat_origin, cfg.app.geodesy.lon_origin = ORIGIN
-        mission = tmp_path / "auv.moos"
-        mission.write_text(MOOS % {"port": db.port, "lat": ORIGIN[0], "lon": ORIGIN[1], "bhv": bhv})
+        mission = write_helm_mission(tmp_path, db.port, bhv, community="auv0", max_speed="4", origin=ORIGIN,
+                                     name="auv.moos")
         helm = start_child("pHelmIvP", ["pHelmIvP", str(mission)], tmp_path)
         try:
             with hosted_translators(cfg, NodeReportTranslation), \

@@ -19,6 +19,7 @@ from gateway.goby.portal.thread import SimpleThread, interprocess_config_of
 from gateway.goby.portal.timeutil import SystemClock
 from util.extensions import ExtensionError
 from util.logsetup import configure_logging
+from util.process import handle_signals
 
 log = logging.getLogger(__name__)
 
@@ -61,14 +62,14 @@ def run_application(
     app: SimpleThread | None = None
     stop_requested = threading.Event()  # a signal during construction must not be lost
 
-    def on_signal() -> None:
+    def on_signal(signum: int) -> None:
+        log.info("received %s; shutting down", signal.Signals(signum).name)
         stop_requested.set()
         if app is not None:
             app.quit()
 
-    restore = _install_signal_handlers(on_signal)
     try:
-        with use_context(context):
+        with handle_signals(on_signal), use_context(context):
             try:
                 app = app_class(cfg)
                 if stop_requested.is_set():
@@ -90,25 +91,4 @@ def run_application(
         if app is not None:
             app.close()
         context.close()
-        restore()
         context.registry.write_if_requested()
-
-
-def _install_signal_handlers(on_signal: Callable[[], None]) -> Callable[[], None]:
-    """SIGINT/SIGTERM -> ``on_signal`` (clean shutdown); returns a function restoring the previous handlers."""
-    if threading.current_thread() is not threading.main_thread():
-        return lambda: None
-    previous = {}
-
-    def handler(signum: int, _frame: object) -> None:
-        log.info("received %s; shutting down", signal.Signals(signum).name)
-        on_signal()
-
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        previous[sig] = signal.signal(sig, handler)
-
-    def restore() -> None:
-        for sig, old in previous.items():
-            signal.signal(sig, old)
-
-    return restore
