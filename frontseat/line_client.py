@@ -12,9 +12,10 @@ import socket
 import threading
 from collections import deque
 
+from frontseat.simulator.protocol import LineSplitter, encode_lines
+
 log = logging.getLogger(__name__)
 
-DELIMITER = b"\r\n"
 
 
 class LineClient:
@@ -92,7 +93,7 @@ class LineClient:
             if sock is None:
                 return False
             try:
-                sock.sendall(line.encode() + DELIMITER)
+                sock.sendall(encode_lines([line]))
                 return True
             except TimeoutError:
                 # the peer stopped reading: a partial line may be on the wire, so start over on a new connection
@@ -134,8 +135,7 @@ class LineClient:
                 self._closing.wait(self.reconnect_interval)
 
     def _read_until_closed(self, sock: socket.socket) -> None:
-        buffer = bytearray()
-        discarding = False
+        splitter = LineSplitter(self.max_line)
         while True:
             try:
                 data = sock.recv(65536)
@@ -145,19 +145,9 @@ class LineClient:
                 return
             if not data:
                 return
-            buffer += data
-            while (end := buffer.find(DELIMITER)) >= 0:
-                line = bytes(buffer[:end])
-                del buffer[: end + len(DELIMITER)]
-                if discarding:
-                    discarding = False
-                    continue
-                self._lines.append(line.decode("utf-8", errors="replace"))
-            if len(buffer) > self.max_line:
-                if not discarding:
-                    log.error("%s sent a line longer than %d bytes; discarding it", self.address, self.max_line)
-                discarding = True
-                del buffer[:-1]
+            self._lines.extend(splitter.feed(data))
+            if splitter.overflowed:
+                log.error("%s sent a line longer than %d bytes; discarding it", self.address, self.max_line)
 
 
 def _shutdown(sock: socket.socket) -> None:

@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import os
 import shutil
@@ -19,9 +20,8 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+from frontseat.simulator.protocol import LineSplitter, encode_lines
 from util.process import ChildProcess, ProcessError
-
-DELIMITER = b"\r\n"
 
 
 @dataclass
@@ -76,11 +76,12 @@ class SimClient:
     def __init__(self, port: int, host: str = "127.0.0.1", timeout: float = 20.0) -> None:
         self.sock = socket.create_connection((host, port), timeout=timeout)
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self._buffer = bytearray()
+        self._splitter = LineSplitter()
+        self._lines: collections.deque[str] = collections.deque()
 
     def send(self, *lines: str) -> None:
         """Send each line with ``\\r\\n`` (all in one write)."""
-        self.sock.sendall(b"".join(line.encode() + DELIMITER for line in lines))
+        self.sock.sendall(encode_lines(lines))
 
     def send_bytes(self, data: bytes) -> None:
         self.sock.sendall(data)
@@ -88,7 +89,7 @@ class SimClient:
     def read_line(self, timeout: float = 20.0) -> str:
         """The next line (without ``\\r\\n``); TimeoutError if none arrives in time."""
         deadline = time.monotonic() + timeout
-        while (end := self._buffer.find(DELIMITER)) < 0:
+        while not self._lines:
             remaining = deadline - time.monotonic()
             if remaining <= 0:
                 raise TimeoutError("no line from the simulator")
@@ -96,10 +97,8 @@ class SimClient:
             chunk = self.sock.recv(65536)
             if not chunk:
                 raise ConnectionError("simulator closed the connection")
-            self._buffer += chunk
-        line = bytes(self._buffer[:end]).decode()
-        del self._buffer[: end + len(DELIMITER)]
-        return line
+            self._lines.extend(self._splitter.feed(chunk))
+        return self._lines.popleft()
 
     def read_until(self, predicate: Callable[[str], bool], timeout: float = 20.0) -> list[str]:
         """Lines up to and including the first one matching ``predicate``."""

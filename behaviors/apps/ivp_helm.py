@@ -10,7 +10,6 @@ a failure it cannot serve through (start-up, or an error outside the loop) ends 
 
 from __future__ import annotations
 
-import argparse
 import logging
 import threading
 import time
@@ -18,9 +17,9 @@ from pathlib import Path
 
 from behaviors.helm.config import config_from_mission
 from behaviors.helm.helm import Helm, Post
+from gateway.apps.moos_tool_args import parse_moos_app_args
 from gateway.moos import MissionFileError, MoosClock, comms
 from gateway.moos.mission_file import MissionFile
-from util.logsetup import add_verbosity_argument, configure_logging
 from util.process import handle_signals
 
 log = logging.getLogger(__name__)
@@ -176,12 +175,7 @@ class HelmApp:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="ivp-helm", description="A pHelmIvP-compatible helm in Python.")
-    parser.add_argument("mission", help=".moos mission file with a ProcessConfig = pHelmIvP block")
-    parser.add_argument("--alias", help="MOOS name (and ProcessConfig block) to use instead of pHelmIvP")
-    add_verbosity_argument(parser)
-    args = parser.parse_args(argv)
-    configure_logging(args.verbose, args.alias or DEFAULT_APP_NAME)
+    args = parse_moos_app_args(argv, "ivp-helm", "A pHelmIvP-compatible helm in Python.", DEFAULT_APP_NAME)
     try:
         app = HelmApp(args.mission, alias=args.alias)
     except MissionFileError as exc:

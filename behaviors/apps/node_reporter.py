@@ -7,16 +7,15 @@ on-connect callback (registrations); the thread that calls :meth:`NodeReporterAp
 
 from __future__ import annotations
 
-import argparse
 import logging
 import threading
 import time
 from pathlib import Path
 
 from behaviors.node_reporter import REGISTRATIONS, NodeReporter, NodeReporterConfig
+from gateway.apps.moos_tool_args import parse_moos_app_args
 from gateway.moos import MissionFileError, MoosClock, comms
 from gateway.moos.mission_file import MissionFile
-from util.logsetup import add_verbosity_argument, configure_logging
 from util.process import handle_signals
 
 log = logging.getLogger(__name__)
@@ -71,13 +70,8 @@ class NodeReporterApp:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="node-reporter",
-                                     description="NODE_REPORT_LOCAL from NAV_*, as pNodeReporter posts it.")
-    parser.add_argument("mission", help=".moos mission file (ProcessConfig = pNodeReporter)")
-    parser.add_argument("--alias", help="MOOS name (and ProcessConfig block) to use instead of pNodeReporter")
-    add_verbosity_argument(parser)
-    args = parser.parse_args(argv)
-    configure_logging(args.verbose, args.alias or DEFAULT_APP_NAME)
+    args = parse_moos_app_args(argv, "node-reporter", "NODE_REPORT_LOCAL from NAV_*, as pNodeReporter posts it.",
+                               DEFAULT_APP_NAME)
     try:
         app = NodeReporterApp(args.mission, alias=args.alias)
     except MissionFileError as exc:

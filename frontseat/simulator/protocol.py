@@ -25,6 +25,48 @@ _DOUBLE = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)
 _INT = re.compile(r"[+-]?\d+")
 
 
+class LineSplitter:
+    """Bytes in, complete lines out: the one ``\\r\\n`` framing of the protocol (simulator, driver, test client).
+
+    Lines are decoded as UTF-8 (invalid bytes replaced). A line longer than ``max_line`` bytes is discarded up to its
+    next delimiter; :attr:`overflowed` is True after the :meth:`feed` that started discarding one (to log it once).
+    :attr:`partial` is the number of bytes of an unfinished, not discarded line.
+    """
+
+    def __init__(self, max_line: int = 64 * 1024) -> None:
+        self.max_line = max_line
+        self.overflowed = False
+        self._buffer = bytearray()
+        self._discarding = False
+
+    @property
+    def partial(self) -> int:
+        return 0 if self._discarding else len(self._buffer)
+
+    def feed(self, data: bytes) -> list[str]:
+        """The lines completed by ``data``, in order."""
+        self._buffer += data
+        lines = []
+        while (end := self._buffer.find(DELIMITER)) >= 0:
+            raw = bytes(self._buffer[:end])
+            del self._buffer[: end + len(DELIMITER)]
+            if self._discarding:
+                self._discarding = False
+                continue
+            lines.append(raw.decode("utf-8", errors="replace"))
+        self.overflowed = False
+        if len(self._buffer) > self.max_line:
+            self.overflowed = not self._discarding
+            self._discarding = True
+            del self._buffer[:-1]  # keep the last byte: it may be the '\\r' of a delimiter split across reads
+        return lines
+
+
+def encode_lines(lines: list[str] | tuple[str, ...]) -> bytes:
+    """Lines as bytes on the wire, each ended by ``\\r\\n``."""
+    return b"".join(line.encode() + DELIMITER for line in lines)
+
+
 def line_key(line: str) -> str:
     """The first comma-separated token (the message type), even for a line whose fields are malformed."""
     return line.split(",", 1)[0]

@@ -17,7 +17,7 @@ import time
 from dataclasses import dataclass, field
 
 from frontseat.simulator.model import Simulation
-from frontseat.simulator.protocol import DELIMITER
+from frontseat.simulator.protocol import LineSplitter, encode_lines
 from util.sockets import accept_client
 
 log = logging.getLogger(__name__)
@@ -31,9 +31,8 @@ MAX_LAG = 1.0  # seconds behind schedule before the tick clock is reset instead 
 class _Client:
     sock: socket.socket
     peer: str
-    inbuf: bytearray = field(default_factory=bytearray)
+    lines: LineSplitter = field(default_factory=lambda: LineSplitter(MAX_LINE))
     outbuf: bytearray = field(default_factory=bytearray)
-    discarding: bool = False  # inside an over-long line, dropping bytes up to the next delimiter
 
 
 class SimulatorServer:
@@ -152,28 +151,10 @@ class SimulatorServer:
         if not data:
             self._drop(client, "disconnected")
             return
-        client.inbuf += data
-        while True:
-            end = client.inbuf.find(DELIMITER)
-            if end < 0:
-                break
-            raw = bytes(client.inbuf[:end])
-            del client.inbuf[: end + len(DELIMITER)]
-            if client.discarding:
-                client.discarding = False
-                continue
-            self._pending.append(raw.decode("utf-8", errors="replace"))
-        if len(client.inbuf) > MAX_LINE:
-            if not client.discarding:
-                log.error(
-                    "client %s sent a line longer than %d bytes (lines must end with \\r\\n); "
-                    "discarding it up to the next \\r\\n",
-                    client.peer,
-                    MAX_LINE,
-                )
-            client.discarding = True
-            # keep the last byte: it may be the '\r' of a delimiter split across reads
-            del client.inbuf[:-1]
+        self._pending.extend(client.lines.feed(data))
+        if client.lines.overflowed:
+            log.error("client %s sent a line longer than %d bytes (lines must end with \\r\\n); "
+                      "discarding it up to the next \\r\\n", client.peer, MAX_LINE)
 
     def _tick(self) -> None:
         lines, self._pending = self._pending, []
@@ -182,7 +163,7 @@ class SimulatorServer:
             out.extend(self.simulation.handle_line(line))
         out.extend(self.simulation.tick())
         if out:
-            self._broadcast(b"".join(text.encode() + DELIMITER for text in out))
+            self._broadcast(encode_lines(out))
 
     def _broadcast(self, payload: bytes) -> None:
         for client in list(self._clients.values()):
@@ -207,8 +188,8 @@ class SimulatorServer:
     def _drop(self, client: _Client, why: str) -> None:
         if self._clients.pop(client.sock, None) is None:
             return
-        if client.inbuf and not client.discarding:
-            log.info("client %s left a partial line of %d bytes; discarded", client.peer, len(client.inbuf))
+        if client.lines.partial:
+            log.info("client %s left a partial line of %d bytes; discarded", client.peer, client.lines.partial)
         log.info("client %s %s (%d connected)", client.peer, why, len(self._clients))
         try:
             self._selector.unregister(client.sock)

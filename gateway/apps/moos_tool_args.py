@@ -1,4 +1,5 @@
-"""Command-line conventions shared by moos-poke and moos-scope (uPokeDB / uXMS style)."""
+"""Command-line conventions of the MOOS tools and apps: moos-poke and moos-scope (uPokeDB / uXMS style) and a MOOS
+application's ``MISSION [--alias NAME]`` (ivp-helm, node-reporter)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from gateway.moos.client import comms
 from gateway.moos.clock import MAX_WARP, MoosClock
 from gateway.moos.errors import MissionFileError
 from gateway.moos.mission_file import MissionFile
+from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
 
@@ -67,3 +69,15 @@ def adopt_db_time_warp(client: comms, clock: MoosClock) -> float:
         if clock.skew != 0.0:  # time correction is on (remote DB or quiet): skew = DB time - our warped time
             clock.skew = welcome.db_time - now * warp
     return warp
+
+
+def parse_moos_app_args(argv: list[str] | None, prog: str, description: str, process: str) -> argparse.Namespace:
+    """A MOOS application's command line, as a CMOOSApp takes it: the mission file, ``--alias NAME`` (MOOS name and
+    ProcessConfig block instead of ``process``) and ``-v``; configures logging under that name."""
+    parser = argparse.ArgumentParser(prog=prog, description=description)
+    parser.add_argument("mission", help=f".moos mission file with a ProcessConfig = {process} block")
+    parser.add_argument("--alias", help=f"MOOS name (and ProcessConfig block) to use instead of {process}")
+    add_verbosity_argument(parser)
+    args = parser.parse_args(argv)
+    configure_logging(args.verbose, args.alias or process)
+    return args

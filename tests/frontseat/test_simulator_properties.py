@@ -57,3 +57,23 @@ def test_each_step_respects_the_rate_limits(heading: float, speed: float, depth:
         assert abs(v.v - before[1]) <= 0.5 * dt + 1e-9
         assert abs(v.z - before[2]) <= 2 * dt + 1e-9
         assert math.hypot(v.x - before[3], v.y - before[4]) <= abs(v.v) * dt + 1e-9
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.text(alphabet=st.characters(blacklist_categories=("Cs",), blacklist_characters="\r\n"), max_size=20), max_size=10),
+       st.lists(st.integers(min_value=1, max_value=7), min_size=1, max_size=5))
+def test_the_line_splitter_returns_the_same_lines_however_the_bytes_are_cut(lines: list[str], cuts: list[int]) -> None:
+    wire = protocol.encode_lines(lines)
+    splitter, got, at, i = protocol.LineSplitter(), [], 0, 0
+    while at < len(wire):
+        size = cuts[i % len(cuts)]
+        got += splitter.feed(wire[at:at + size])
+        at, i = at + size, i + 1
+    assert got == lines and splitter.partial == 0
+
+
+def test_the_line_splitter_drops_an_over_long_line_once_and_keeps_the_next() -> None:
+    splitter = protocol.LineSplitter(max_line=8)
+    assert splitter.feed(b"0123456789abc") == [] and splitter.overflowed
+    assert splitter.feed(b"def\r") == [] and not splitter.overflowed
+    assert splitter.feed(b"\nNAV,X:1\r\n") == ["NAV,X:1"]

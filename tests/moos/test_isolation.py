@@ -12,7 +12,8 @@ from pathlib import Path
 
 from gateway.moos.codec import PROTOCOL_BYTES, encode_packet
 from gateway.moos.message import DATA, DOUBLE, NOTIFY, REGISTER, STRING, TIMING, MoosMessage
-from gateway.moos.testing import connected_comms, moosdb_process, wait_for
+from gateway.moos.testing import connected_comms, moosdb_process
+from util.process import wait_until
 
 TOTAL_CAP = 8 * 1024 * 1024
 OUTBOX_CAP = 1024 * 1024
@@ -113,7 +114,7 @@ def test_good_clients_unaffected_by_slow_readers_and_partial_packets(tmp_path: P
     caps = [f"--max_outbox_bytes={OUTBOX_CAP}", f"--max_buffered_bytes={TOTAL_CAP}",
             f"--max_packet_bytes={PACKET_CAP}"]
     with moosdb_process(tmp_path, extra_args=caps) as db:
-        pid = db.proc.pid  # type: ignore[union-attr]
+        pid = db.pid
         with connected_comms(db.port, "alice", ["SEQ_B"]) as alice, connected_comms(db.port, "bob", ["SEQ_A"]) as bob:
             rss_start = rss(pid)
             arrivals: dict[str, list[tuple[float, int]]] = {"SEQ_A": [], "SEQ_B": []}
@@ -145,7 +146,7 @@ def test_good_clients_unaffected_by_slow_readers_and_partial_packets(tmp_path: P
                     assert bob.notify("SEQ_B", float(i))
                     if i % 10 == 9:
                         time.sleep(0.01)
-                wait_for(lambda: all(len(v) >= PER_CLIENT for v in arrivals.values()), 30)
+                wait_until(lambda: all(len(v) >= PER_CLIENT for v in arrivals.values()), 30, "every arrival")
             done.set()
             for t in threads:
                 t.join(10)
