@@ -51,10 +51,10 @@ def wildcard(addresses: set[str]) -> set[str]:
 
 def test_moos_db_binds_loopback_unless_asked(tmp_path: Path) -> None:
     with moosdb_process(tmp_path) as db:
-        got = listening_addresses(db.proc.pid)  # type: ignore[union-attr]
+        got = listening_addresses(db.pid)
         assert got == {f"127.0.0.1:{db.port}"}
     with moosdb_process(tmp_path, extra_args=["--moos_address=0.0.0.0"]) as db:
-        assert wildcard(listening_addresses(db.proc.pid)) == {f"0.0.0.0:{db.port}"}  # type: ignore[union-attr]
+        assert wildcard(listening_addresses(db.pid)) == {f"0.0.0.0:{db.port}"}
 
 
 def test_tcp_broker_binds_its_configured_address(tmp_path: Path) -> None:

@@ -10,10 +10,10 @@ prints a summary. Exit status 0 only if the mission ran and every process stoppe
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import logging
 import shutil
-import signal
 import sys
 import tempfile
 import time
@@ -31,6 +31,7 @@ from launch.trail.plot import write_trail_png
 from launch.trail.settings import TrailSettings, Vehicle
 from launch.trail.summary import progress_line, summary_text
 from util.logsetup import add_verbosity_argument, configure_logging
+from util.process import handle_signals
 
 log = logging.getLogger(__name__)
 
@@ -193,7 +194,8 @@ def run_demo(args: argparse.Namespace) -> int:
     mission.add_hook(links.poll)
     operator_record = MissionRecord()
     workers: list[PortalWorker] = []
-    previous = {s: signal.signal(s, lambda *_: mission.stop_event.set()) for s in (signal.SIGINT, signal.SIGTERM)}
+    signals = contextlib.ExitStack()  # SIGINT/SIGTERM stop the mission; the previous handlers come back in `finally`
+    signals.enter_context(handle_signals(lambda _signum: mission.stop_event.set()))
     failure = None
     started = time.monotonic()
     sim_seconds = 0.0
@@ -228,8 +230,7 @@ def run_demo(args: argparse.Namespace) -> int:
         links.poll()
         links.close()
         result = mission.stop(failure)
-        for s, handler in previous.items():
-            signal.signal(s, handler)
+        signals.close()
         if socket_dir != run_dir:
             shutil.rmtree(socket_dir, ignore_errors=True)
     title = (f"Trail mission: USV ({args.usv_helm} helm) + {n} AUVs, {settings.helm} + {settings.moosdb}, "

@@ -22,12 +22,12 @@ from google.protobuf import text_format
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
 from frontseat.protobuf.frontseat_pb2 import INTERFACE_COMMAND, InterfaceState, InterfaceStatus
-from frontseat.testing import free_tcp_port
 from gateway.goby.portal.protobuf.gobyd_config_pb2 import GobyDaemonConfig
-from gateway.goby.portal.testing import AppProcess, PortalClient
+from gateway.goby.portal.testing import PortalClient, app_process
 from launch.usv.config import generate
 from launch.usv.settings import UsvSettings
 from tests.goby3_real import GOBY_SOVERSION, real_goby_skip_reason, short_ipc_dir
+from util.process import ChildProcess, free_port
 
 pytestmark = pytest.mark.interop
 BIN = Path(sys.executable).parent
@@ -38,7 +38,7 @@ def test_real_interface_and_simulator_reach_command_with_our_moos_side(tmp_path:
     if reason:
         pytest.skip(reason)
     ipc_dir = short_ipc_dir()
-    settings = UsvSettings(run_dir=tmp_path / "run", warp=5, moos_port=free_tcp_port(), sim_port=free_tcp_port(),
+    settings = UsvSettings(run_dir=tmp_path / "run", warp=5, moos_port=free_port(), sim_port=free_port(),
                            socket_name=str(ipc_dir / "goby_usv"))
     configs = {app: tmp_path / f"{app}.pb.cfg" for app in ("broker", "frontseat_interface", "moos_gateway")}
     for app, path in configs.items():
@@ -58,10 +58,10 @@ def test_real_interface_and_simulator_reach_command_with_our_moos_side(tmp_path:
         ([*interface, str(configs["frontseat_interface"])], fs_env),
         ([str(BIN / "moos-gateway"), str(configs["moos_gateway"])], gw_env),
     ]
-    procs: list[AppProcess] = []
+    procs: list[ChildProcess] = []
     try:
         for index, (args, env) in enumerate(commands):
-            procs.append(AppProcess(args, env=env, log_path=tmp_path / f"{index}-{Path(args[0]).name}.log"))
+            procs.append(app_process(args, env=env, log_path=tmp_path / f"{index}-{Path(args[0]).name}.log"))
         with PortalClient(interprocess, "interop_observer") as observer:
             status = observer.collect(groups.status, InterfaceStatus)
             nav = observer.collect(groups.node_status, NodeStatus)
@@ -78,7 +78,7 @@ def test_real_interface_and_simulator_reach_command_with_our_moos_side(tmp_path:
 
             assert observer.poll_until(lambda: moved() > 10.0, 60), f"moved {moved():.1f} m\n{logs()}"
         for proc in procs:
-            assert proc.process.poll() is None, f"{proc.args[0]} exited\n{logs()}"
+            assert proc.running, f"{proc.args[0]} exited\n{logs()}"
     finally:
         for proc in reversed(procs):
             proc.stop()

@@ -14,7 +14,7 @@ import pytest
 
 from frontseat.protobuf.frontseat_pb2 import HELM_DRIVE, INTERFACE_COMMAND, HelmStateReport, InterfaceStatus
 from gateway.goby.portal import Scheme
-from gateway.goby.portal.testing import AppProcess, BrokerProcess, PortalClient
+from gateway.goby.portal.testing import BrokerProcess, PortalClient, app_process
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from tests.goby3_real import interprocess_text, real_goby_skip_reason, short_ipc_dir
 from tests.protobuf.sample_messages_pb2 import Sample
@@ -39,7 +39,7 @@ def _real_gobyd(tmp_path: Path) -> Iterator[InterProcessPortalConfig]:
                                    socket_name=str(ipc_dir / "goby_interop"))
     cfg = tmp_path / "gobyd.pb.cfg"
     cfg.write_text(f"interprocess {{ {interprocess_text(ipc)} }}\n")
-    gobyd = AppProcess(["gobyd", str(cfg)], log_path=tmp_path / "gobyd.log")
+    gobyd = app_process(["gobyd", str(cfg)], log_path=tmp_path / "gobyd.log")
     try:
         yield ipc
     finally:
@@ -83,7 +83,7 @@ def test_real_goby_zeromq_publish_and_subscribe_with_our_client(tmp_path: Path, 
         with PortalClient(ipc, "ours_sub") as ours:
             got = ours.collect("interop::helm", HelmStateReport)
             assert ours.wait_subscribed()
-            publisher = AppProcess(["goby", "zeromq", "publish", "interop::helm",
+            publisher = app_process(["goby", "zeromq", "publish", "interop::helm",
                                     "goby.middleware.frontseat.protobuf.HelmStateReport", "state: HELM_DRIVE",
                                     "--interprocess", interprocess_text(ipc)], log_path=tmp_path / "pub.log")
             try:
@@ -92,7 +92,7 @@ def test_real_goby_zeromq_publish_and_subscribe_with_our_client(tmp_path: Path, 
                 publisher.stop()
         assert got[0].state == HELM_DRIVE
         # us -> Goby: `goby zeromq subscribe GROUP_REGEX` prints "scheme | group | type | time | debug text"
-        subscriber = AppProcess(["goby", "zeromq", "subscribe", "interop::.*", "--interprocess", interprocess_text(ipc)],
+        subscriber = app_process(["goby", "zeromq", "subscribe", "interop::.*", "--interprocess", interprocess_text(ipc)],
                                 log_path=tmp_path / "sub.log")
         try:
             with PortalClient(ipc, "ours_pub") as ours:
@@ -101,7 +101,8 @@ def test_real_goby_zeromq_publish_and_subscribe_with_our_client(tmp_path: Path, 
                 for _ in range(100):
                     ours.publish("interop::status", InterfaceStatus(state=INTERFACE_COMMAND))
                     ours.poll(0.05)
-                    line = subscriber.wait_for("interop::status", 0.2)
+                    found = subscriber.wait_for_output(r"^.*interop::status.*$", 0.2)
+                    line = found.group(0) if found else None
                     if line:
                         break
             assert line is not None, (tmp_path / "sub.log").read_text()

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
-from translator_procs import ORIGIN, ChildProcess, running
+from translator_procs import ORIGIN, running
 
 from frontseat import groups as frontseat_groups
 from frontseat.protobuf import frontseat_data_pb2 as fs
@@ -32,6 +32,7 @@ from translators.testing import GatewayProcess
 from translators.trail import groups
 from translators.usv.protobuf.command_dccl_pb2 import AUVCommand
 from util.geodesy import UTMGeodesy
+from util.process import ChildProcess
 
 pytestmark = pytest.mark.skipif(not loopback_multicast_works(), reason="multicast on 127.0.0.1 is not available here")
 
@@ -107,7 +108,7 @@ def fleet(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Fleet]:
             GatewayProcess(workdir, ["libgoby3_course_moos_gateway_plugin.so"], gateway_cfg, extra_args=["-v"])))
         yield built
         for child in built.children:
-            alive = child.alive() if isinstance(child, ChildProcess) else child.proc.poll() is None
+            alive = child.running if isinstance(child, ChildProcess) else child.proc.running
             assert alive, f"a process died during the tests\n{built.logs()}"
 
 
