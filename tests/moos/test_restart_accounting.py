@@ -10,7 +10,8 @@ import time
 from pathlib import Path
 
 from gateway.moos import comms
-from gateway.moos.testing import connected_comms, moosdb_process, wait_for
+from gateway.moos.testing import connected_comms, moosdb_process
+from util.process import wait_until
 
 N = 6000
 
@@ -41,13 +42,13 @@ def test_db_crash_accounting_is_exact(tmp_path: Path) -> None:
                 if i == N // 2:
                     db.start()
                     with connected_comms(db.port, "probe") as probe:  # -1 arrives once the reader re-registered
-                        assert wait_for(lambda: probe.notify("SEQ", -1.0) and -1 in delivered, 20, interval=0.2)
+                        wait_until(lambda: probe.notify("SEQ", -1.0) and -1 in delivered, 20, "the reader back", interval=0.2)
                     reader_back.set()
                 if not pub.notify("SEQ", float(i)):
                     refused.append(i)
                 if i % 20 == 0:
                     time.sleep(0.01)
-            wait_for(lambda: len(set(delivered) | set(reported) | set(refused)) >= N, 30)
+            wait_until(lambda: len(set(delivered) | set(reported) | set(refused)) >= N, 30, "every message accounted for")
         finally:
             pub.close()
 

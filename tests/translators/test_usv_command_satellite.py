@@ -7,7 +7,7 @@ from __future__ import annotations
 import sys
 
 import pytest
-from translator_procs import ChildProcess, run_cli, wait_until
+from translator_procs import run_cli, start_child, wait_showing_logs
 
 from gateway.goby.intervehicle.testing import (
     broker_config,
@@ -40,13 +40,13 @@ def test_usv_command_over_the_satellite_link(tmp_path):
     try:
         manager_cfg = tmp_path / "manager.pb.cfg"
         manager_cfg.write_text(SIM)
-        manager = ChildProcess("usv_manager", [sys.executable, "-m", "translators.apps.usv_manager",
-                                               str(manager_cfg), "-v"], tmp_path, brokers["usv"].env())
+        manager = start_child("usv_manager", [sys.executable, "-m", "translators.apps.usv_manager",
+                                             str(manager_cfg), "-v"], tmp_path, brokers["usv"].env())
         with PortalClient(brokers["usv"].interprocess_config(), name="usv_probe") as usv:
             commands = usv.collect(usv_groups.usv_command, USVCommand)
             acks = usv.collect(usv_groups.usv_command_ack, USVCommandAck)
             assert usv.wait_subscribed()
-            wait_until(lambda: "waiting for USV commands" in manager.output(), 30, "usv-manager to start", manager)
+            wait_showing_logs(lambda: "waiting for USV commands" in manager.output(), 30, "usv-manager to start", manager)
             tool_cfg = tmp_path / "tool.pb.cfg"
             tool_cfg.write_text(SIM + "intervehicle: true\n")
             result = run_cli(["polygon", "--sides", "5", "--radius", "250", "--timeout", "20", str(tool_cfg)],
