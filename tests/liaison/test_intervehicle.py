@@ -19,7 +19,6 @@ from gateway.goby.intervehicle.testing import (
     random_multicast,
 )
 from gateway.goby.portal.testing import broker_process, running_app
-from launch.config import free_tcp_port
 from launch.liaison.portal_side import LiaisonApp
 from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
 from launch.liaison.settings import load_settings
@@ -28,6 +27,7 @@ from launch.trail.config import generate as trail_generate
 from launch.trail.demo import liaison_urls_line
 from launch.trail.settings import TrailSettings, Vehicle
 from tests.liaison.test_server import receive_until, ws_url
+from util.process import free_port
 
 pytestmark = pytest.mark.skipif(not loopback_multicast_works(), reason="multicast on 127.0.0.1 is not available here")
 
@@ -50,7 +50,7 @@ def topside(tmp_path):
     cfg_file = tmp_path / "topside.pb.cfg"
     cfg_file.write_text(broker_config([link_block(1, group, port, [(1, 5, 64), (2, 5, 64)])], warp=20))
     with broker_process(tmp_path, platform="topside", extra_args=[str(cfg_file)]) as broker:
-        cfg = text_format.Parse(CONFIG.format(port=free_tcp_port()), LiaisonConfig())
+        cfg = text_format.Parse(CONFIG.format(port=free_port()), LiaisonConfig())
         cfg.interprocess.CopyFrom(broker.interprocess_config())
         with running_app(LiaisonApp, cfg) as app:
             yield app
