@@ -21,6 +21,7 @@ recovered.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import random
 import signal
@@ -37,11 +38,11 @@ from gateway.goby.portal.testing import PortalClient
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from gateway.moos import comms
 from gateway.moos.clock import MoosClock
-from launch.config import free_tcp_port
 from launch.process_group import ManagedProcess
 from launch.usv.mission import UsvMission
 from launch.usv.settings import UsvSettings
 from util.logsetup import add_verbosity_argument, configure_logging
+from util.process import free_port, handle_signals
 
 log = logging.getLogger(__name__)
 
@@ -231,13 +232,12 @@ def run(args: argparse.Namespace) -> int:
     rng = random.Random(args.seed)
     out = Path(args.out or tempfile.mkdtemp(prefix="chaos_"))
     socket_dir = Path(tempfile.mkdtemp(prefix="cs", dir="/tmp"))
-    settings = UsvSettings(run_dir=out, warp=args.warp, moos_port=free_tcp_port(), sim_port=free_tcp_port(),
-                           liaison_port=free_tcp_port(), socket_name=str(socket_dir / "goby_usv"))
+    settings = UsvSettings(run_dir=out, warp=args.warp, moos_port=free_port(), sim_port=free_port(),
+                           liaison_port=free_port(), socket_name=str(socket_dir / "goby_usv"))
     mission = UsvMission(settings, report=log.info)
     kills: list[Kill] = []
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    signal.signal(signal.SIGINT, lambda *_: stop.set())
+    signals = contextlib.ExitStack()  # SIGINT/SIGTERM end the soak early; the previous handlers come back at the end
+    stop = signals.enter_context(handle_signals())
     try:
         mission.start()
         mission.wait_for_command(180)
@@ -273,6 +273,7 @@ def run(args: argparse.Namespace) -> int:
             probe.stop()
     finally:
         mission.stop()
+        signals.close()
     print(report(kills, probes, rss_start, rss_end, args))
     lost = sum(len(p.ledger.lost()) for p in probes)
     return 0 if lost == 0 and all(k.recovered_at for k in kills) else 1

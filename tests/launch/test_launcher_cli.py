@@ -183,3 +183,20 @@ def test_preseed_next_to_the_launch_file_is_sourced_for_every_command(tmp_path):
     assert "Sourcing" in output
     assert "one=seeded" in (logs / "one.log").read_text()
     assert "two=seeded" in (logs / "two.log").read_text()
+
+
+def test_respawn_starts_an_ended_process_again_and_appends_to_its_log(tmp_path):
+    from launch.launchfile import parse_lines
+    from launch.process_group import ProcessGroup
+
+    entry = parse_lines(["[name=once] bash -c 'sleep 0.3; echo run $$; exit 3'"], source="t").entries[0]
+    with ProcessGroup([entry], tmp_path / "logs", launch_delay_s=0, startup_check_s=0, report=lambda _l: None) as group:
+        group.start()
+        (first,) = group.processes
+        wait_until(lambda: not first.running, 20, "the first run to end")
+        pid = first.pid
+        again = group.respawn(first)
+        assert again is group.processes[0] and again.pid != pid
+        wait_until(lambda: not again.running, 20, "the second run to end")
+        assert again.returncode == 3
+    assert (tmp_path / "logs" / "once.log").read_text().count("run ") == 2

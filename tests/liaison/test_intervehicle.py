@@ -11,7 +11,6 @@ import aiohttp
 import pytest
 from google.protobuf import text_format
 
-from frontseat.testing import wait_until
 from gateway.goby.intervehicle.testing import (
     broker_config,
     link_block,
@@ -27,7 +26,7 @@ from launch.trail.config import generate as trail_generate
 from launch.trail.demo import liaison_urls_line
 from launch.trail.settings import TrailSettings, Vehicle
 from tests.liaison.test_server import receive_until, ws_url
-from util.process import free_port
+from util.process import free_port, wait_until
 
 pytestmark = pytest.mark.skipif(not loopback_multicast_works(), reason="multicast on 127.0.0.1 is not available here")
 
