@@ -183,6 +183,9 @@ def test_bad_frames_are_dropped_with_one_line_and_the_link_keeps_running(sat, ca
     bad = ModemTransmission(src=2, dest=1, type=ModemTransmission.DATA, ack_requested=False)
     bad.frame.append(bytes([0x80 | 0x7F, 0x50, 1, 2, 3]))  # a two-byte DCCL id nobody loaded
     ether.send(bad.SerializeToString())
+    truncated = ModemTransmission(src=2, dest=1, type=ModemTransmission.DATA, ack_requested=False)
+    truncated.frame.append(b"\x06\x00\x00")  # the start of a Subscription (id 3), cut short
+    ether.send(truncated.SerializeToString())
     stranger = ModemTransmission(src=9, dest=1, type=ModemTransmission.DATA, ack_requested=False)
     stranger.frame.append(b"\x06\x00")
     ether.send(stranger.SerializeToString())
@@ -191,7 +194,8 @@ def test_bad_frames_are_dropped_with_one_line_and_the_link_keeps_running(sat, ca
     assert "not a ModemTransmission" in text
     assert "is not loaded here" in text
     assert "unknown modem 9" in text
-    assert topside.link.counters.dropped_frames == 2
+    assert "frame from modem 2: cannot decode" in text
+    assert topside.link.counters.dropped_frames == 3
     subscribe(usv, codec, USVCommand, 0, publisher=1)
     run(clock, [topside, usv], 12)
     assert usv.acks  # still working
