@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from .behavior import Behavior, parse_bool, parse_float
+from .cruise_speed import CruiseSpeed
 from .errors import ParamError
 from .geometry import Polygon, fmt_num, rel_ang, segment_angle
 from .ivp import ObjectiveFunction, zaic_peak
@@ -12,7 +13,7 @@ from .point_strings import parse_point, parse_polygon
 from .waypoint_engine import WaypointEngine
 
 
-class LoiterBehavior(Behavior):
+class LoiterBehavior(CruiseSpeed, Behavior):
     TYPE = "BHV_Loiter"
     DEFAULT_NAME = "bhv_loiter"
     DOMAIN_VARS = ("course", "speed")
@@ -23,9 +24,7 @@ class LoiterBehavior(Behavior):
         self.polygon_spec = ""
         self.clockwise = True
         self.clockwise_best = False
-        self.speed = 0.0
-        self.speed_alt = -1.0
-        self.use_alt_speed = False
+        self._init_cruise_speed()
         self.acquire_dist = 10.0
         self.center_activate = False
         self.patience = 50.0
@@ -51,12 +50,8 @@ class LoiterBehavior(Behavior):
                 self.clockwise_best = False
                 self.clockwise = parse_bool(value, param)
                 self._apply_direction()
-        elif param == "speed":
-            self.speed = parse_float(value, param, low=0.0)
-        elif param == "speed_alt":
-            self.speed_alt = parse_float(value, param)
-        elif param == "use_alt_speed":
-            self.use_alt_speed = parse_bool(value, param)
+        elif self._set_cruise_speed_param(param, value):
+            pass
         elif param in ("capture_radius", "radius"):
             self.engine.capture_radius = parse_float(value, param, low=0.0)
         elif param in ("slip_radius", "nm_radius"):
@@ -141,10 +136,6 @@ class LoiterBehavior(Behavior):
         self.engine.set_points(self.polygon.vertices)
         self.engine.set_index(index)
 
-    def desired_speed(self) -> float:
-        speed = self.speed_alt if self.use_alt_speed and self.speed_alt >= 0 else self.speed
-        return min(speed, self.domain.vars["speed"].high)
-
     def on_set_param_complete(self) -> None:
         if self.polygon is None:
             return
@@ -153,7 +144,7 @@ class LoiterBehavior(Behavior):
                                   f"clockwise={str(self.clockwise).lower()},"
                                   f"dynamic_clockwise={str(self.clockwise_best).lower()},"
                                   f"center_activate={str(self.center_activate).lower()},"
-                                  f"desired_speed={fmt_num(self.desired_speed())},"
+                                  f"desired_speed={fmt_num(self.cruise_speed())},"
                                   f"polygon=\"{self.polygon.spec()}\"", repeatable=True)
 
     # ---- states --------------------------------------------------------------------------------
@@ -196,7 +187,7 @@ class LoiterBehavior(Behavior):
         self._post_status(dist)
         self.post("VIEW_POLYGON", f"{self.polygon.spec()},label={self.ownship}_{self.name}")
         course, speed = self.domain.vars["course"], self.domain.vars["speed"]
-        spd = zaic_peak(speed, self.desired_speed(), 0, 0.3, 0, 0, 100)
+        spd = zaic_peak(speed, self.cruise_speed(), 0, 0.3, 0, 0, 100)
         crs = zaic_peak(course, rel_ang(osx, osy, self._ptx, self._pty), 0, 180, 0, 0, 100, wrap=True)
         return ObjectiveFunction.coupled(self.pwt, "course", crs, self.patience, "speed", spd, 100 - self.patience)
 
@@ -247,6 +238,6 @@ class LoiterBehavior(Behavior):
         self.post("LOITER_ACQUIRE" + sfx, 1.0 if self.acquire_mode else 0.0)
         if dist is not None:
             self.post("LOITER_DIST_TO_POLY" + sfx, float(round(dist)) if dist > 10 else round(dist, 2))
-            speed = self.desired_speed()
+            speed = self.cruise_speed()
             if speed > 0:
                 self.post("LOITER_ETA_TO_POLY" + sfx, round(max(dist, 0.0) / speed, 2))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from .behavior import Behavior, parse_bool, parse_float
+from .cruise_speed import CruiseSpeed
 from .errors import ParamError
 from .flags import Flag
 from .geometry import Point, fmt_num, perp_on_segment, project, rel_ang
@@ -13,7 +14,7 @@ from .point_strings import parse_point, parse_seglist
 from .waypoint_engine import WaypointEngine
 
 
-class WaypointBehavior(Behavior):
+class WaypointBehavior(CruiseSpeed, Behavior):
     TYPE = "BHV_Waypoint"
     DEFAULT_NAME = "bhv_waypoint"
     DOMAIN_VARS = ("course", "speed")
@@ -23,9 +24,7 @@ class WaypointBehavior(Behavior):
         self.engine = WaypointEngine()
         self.engine.capture_radius = 3.0
         self.engine.slip_radius = 15.0
-        self.speed = 0.0
-        self.speed_alt = -1.0
-        self.use_alt_speed = False
+        self._init_cruise_speed()
         self.lead = -1.0
         self.lead_damper = -1.0
         self.lead_to_start = False
@@ -56,12 +55,8 @@ class WaypointBehavior(Behavior):
                 self._set_points([])
             else:
                 self._set_points([parse_point(value)] if param == "point" else parse_seglist(value))
-        elif param == "speed":
-            self.speed = parse_float(value, param, low=0.0)
-        elif param == "speed_alt":
-            self.speed_alt = parse_float(value, param)
-        elif param == "use_alt_speed":
-            self.use_alt_speed = parse_bool(value, param)
+        elif self._set_cruise_speed_param(param, value):
+            pass
         elif param in ("capture_radius", "radius"):
             eng.capture_radius = parse_float(value, param, low=0.0)
             if eng.capture_radius <= 0:
@@ -138,10 +133,6 @@ class WaypointBehavior(Behavior):
         perpetual_state = (self.engine.repeat, self.engine.repeat_forever)
         self.engine.set_points(pts)
         self.engine.repeat, self.engine.repeat_forever = perpetual_state
-
-    def cruise_speed(self) -> float:
-        speed = self.speed_alt if self.use_alt_speed and self.speed_alt >= 0 else self.speed
-        return min(speed, self.domain.vars["speed"].high) if self.domain.has("speed") else speed
 
     def on_set_param_complete(self) -> None:
         pts = ":".join(f"{fmt_num(x)},{fmt_num(y)}" for x, y in self.engine.points)
