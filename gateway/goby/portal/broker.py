@@ -42,6 +42,9 @@ log = logging.getLogger(__name__)
 READY_PREFIX = "goby-broker ready: "  # goby-broker's stdout line when serving, then JSON endpoints
 
 
+MAX_MESSAGE_BYTES = 64 * 1024 * 1024
+
+
 class BrokerError(PortalError):
     """The broker cannot start (e.g. another broker already serves the platform)."""
 
@@ -64,8 +67,10 @@ def _ipc_in_use(path: str) -> bool:
 class Broker:
     """Router + manager for one platform.  ``start()`` binds and returns when ready; ``stop()`` is idempotent."""
 
-    def __init__(self, cfg: GobyDaemonConfig | None = None) -> None:
+    def __init__(self, cfg: GobyDaemonConfig | None = None, max_message_bytes: int = MAX_MESSAGE_BYTES) -> None:
         self.cfg = cfg if cfg is not None else GobyDaemonConfig()
+        # ZeroMQ would allocate whatever a frame header announces; past this the sender is disconnected instead.
+        self.max_message_bytes = int(max_message_bytes)
         self.ipc: InterProcessPortalConfig = self.cfg.interprocess
         self.required_clients = frozenset(self.cfg.hold.required_client)
         self.reported_clients: set[str] = set()
@@ -117,6 +122,7 @@ class Broker:
             sock.setsockopt(zmq.RCVHWM, self.ipc.receive_queue_size)
             sock.setsockopt(zmq.IPV6, 1)
             sock.setsockopt(zmq.LINGER, 0)
+            sock.setsockopt(zmq.MAXMSGSIZE, self.max_message_bytes)
         try:
             if self.is_tcp:  # the configured address only (Goby's ipv4_address, default 127.0.0.1)
                 self.pub_port = xpub.bind_to_random_port(self._tcp_host())
@@ -143,6 +149,7 @@ class Broker:
 
         rep = self._mctx.socket(zmq.REP)
         rep.setsockopt(zmq.LINGER, 0)
+        rep.setsockopt(zmq.MAXMSGSIZE, self.max_message_bytes)
         rep.setsockopt(zmq.IPV6, 1)
         try:
             endpoint = manager_endpoint(self.ipc)
