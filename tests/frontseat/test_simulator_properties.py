@@ -39,9 +39,9 @@ def test_no_line_makes_the_model_raise(lines: list[str]) -> None:
 
 @settings(max_examples=100, deadline=None)
 @given(
-    heading=st.floats(-720, 720),
-    speed=st.floats(-5, 5),
-    depth=st.floats(-50, 50),
+    heading=st.floats(-360, 360),  # the whole range a CMD may ask (model.COMMAND_RANGES); beyond it is refused
+    speed=st.floats(0, 5),
+    depth=st.floats(0, 50),
     steps=st.integers(1, 60),
 )
 def test_each_step_respects_the_rate_limits(heading: float, speed: float, depth: float, steps: int) -> None:
