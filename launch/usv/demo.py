@@ -25,7 +25,7 @@ from pathlib import Path
 from gateway.goby.acomms.udp_multicast import random_multicast
 from launch.errors import LaunchError, MissionConfigError
 from launch.usv.analysis import bhv_waypoints, command_effects, loiter_phases, transitions
-from launch.usv.mission import MissionResult, UsvMission, choose_program
+from launch.usv.mission import MissionResult, UsvMission, choose_program, liaison_page_urls
 from launch.usv.plot import write_track_png
 from launch.usv.settings import DEFAULT_SCHEDULE, KAUAI_ORIGIN, UsvSettings
 from launch.usv.shore import SCHEDULE_HELP, parse_schedule
@@ -207,7 +207,9 @@ def run_demo(args: argparse.Namespace) -> int:
         urls = mission.liaison_urls()
         print("web pages of this run (goby-liaison): " + ", ".join(f"{view} {url}" for view, url in urls.items()),
               flush=True)
-        topside = mission.liaison_urls(process_name="topside.liaison")
+        # its port is settled (make_settings): no wait for a second page's start on a loaded machine
+        host = "127.0.0.1" if settings.liaison_address in ("", "0.0.0.0", "::") else settings.liaison_address
+        topside = liaison_page_urls(f"http://{host}:{settings.topside_liaison_port}")
         print("topside page (goby-liaison, commands over the satellite link): "
               + ", ".join(f"{view} {url}" for view, url in topside.items()), flush=True)
         if mission.wait_for_command() is not None:

@@ -40,6 +40,13 @@ class MissionResult:
     failure: str | None = None
 
 
+def liaison_page_urls(base: str) -> dict[str, str]:
+    """A goby-liaison's pages (home, scope, commander, map) under ``base`` (``http://host:port``)."""
+    base = base.rstrip("/")
+    return {"home": f"{base}/", "scope": f"{base}/?_=/scope", "commander": f"{base}/?_=/commander",
+            "map": f"{base}/?_=/map"}
+
+
 class UsvMission:
     """One run of the USV mission. Call ``start()``, then ``run()``, and always ``stop()`` (or use ``with``)."""
 
@@ -124,9 +131,7 @@ class UsvMission:
                 text = ""
             match = re.search(rf"{re.escape(LIAISON_READY)} (\S+)", text)
             if match:
-                base = match.group(1).rstrip("/")
-                return {"home": f"{base}/", "scope": f"{base}/?_=/scope", "commander": f"{base}/?_=/commander",
-                        "map": f"{base}/?_=/map"}
+                return liaison_page_urls(match.group(1))
             if time.monotonic() > deadline or self.stop_event.is_set():
                 raise LaunchError(f"goby-liaison did not report its address within {timeout_s:g} s "
                                   f"(log {process.log_path})")

@@ -81,7 +81,8 @@ def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(
     proc = ChildProcess(
         [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--forever", "--warp", "20",
          "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_port()),
-         "--sim-port", str(free_port()), "--liaison-port", str(free_port())],
+         "--sim-port", str(free_port()), "--liaison-port", str(free_port()),
+         "--topside-liaison-port", str(free_port())],
         tmp_path / "run.out",
     ).start()
     try:
@@ -93,6 +94,8 @@ def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(
     assert proc.returncode == 0, text
     assert "=== USV mission summary" in text
     assert "processes: 11/11 exited cleanly" in text
+    assert re.search(r"^topside page \(goby-liaison, commands over the satellite link\): home http://127\.0\.0\.1:\d+/",
+                     text, flags=re.M), text
     assert "1. t=" in text and "POLYGON_UPDATES=polygon=radial::x=0,y=0,radius=200,pts=6" in text
     rows = list(csv.DictReader(open(out_dir / "track.csv")))
     assert len(rows) > 50
@@ -152,12 +155,14 @@ def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(t
     proc = ChildProcess(
         [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--forever", "--warp", "20",
          "--schedule", "none", "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_port()),
-         "--sim-port", str(free_port()), "--liaison-port", str(free_port())],
+         "--sim-port", str(free_port()), "--liaison-port", str(free_port()),
+         "--topside-liaison-port", str(free_port())],
         tmp_path / "run.out",
     ).start()
     sent: subprocess.CompletedProcess[str] | None = None
     try:
-        commander = expect(proc, r"Command it from the browser: (http://127\.0\.0\.1:\d+/\?_=/commander)\n")
+        commander = expect(proc, r"Command it from the browser: (http://127\.0\.0\.1:\d+/\?_=/commander) \(over the "
+                           r"satellite link\)")
         assert urllib.request.urlopen(commander.group(1), timeout=10).status == 200  # the page is served
         block = expect(proc, r"or, in another terminal \(bash\):\n"
                              r"  (export .*)\n  (.* waypoints .*)\n  (.* polygon .*)\n")
@@ -182,6 +187,8 @@ def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(t
     assert "  2. t=" not in text and "acknowledgements: 1 posted to MOOS, 0 refused" in text, text
     assert re.search(r"^waypoints phase t=\d+\.\.\d+ s \(\d+ s, until the end of the run\)", text, flags=re.M), text
     assert "processes: 11/11 exited cleanly" in text
+    assert re.search(r"^topside page \(goby-liaison, commands over the satellite link\): home http://127\.0\.0\.1:\d+/",
+                     text, flags=re.M), text
     shore_log = (out_dir / "run" / "logs" / "usv.shore.log").read_text()
     assert "no commands planned" in shore_log and "sent " not in shore_log, shore_log
     headings = [float(h) for h in re.findall(r"hdg=\s*([-\d.]+)", text)]
