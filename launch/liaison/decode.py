@@ -2,8 +2,9 @@
 
 PROTOBUF payloads of a type imported in this process are shown in protobuf text format, DCCL payloads too
 (decoded by the project's DCCL codec, ``gateway.goby.dccl``: the intervehicle layer republishes what it sends and
-receives under both schemes); CSTR as the string; anything else (an unknown type, a scheme without a decoder, a payload that does not parse, one larger than
-``max_message_size_bytes``) as its size and the first bytes in hex, so nothing is hidden.
+receives under both schemes); CSTR as the string; anything else (an unknown type, a scheme without a decoder, a
+payload that does not parse, one larger than ``max_message_size_bytes``) as its size and the first bytes in hex,
+so nothing is hidden.
 """
 
 from __future__ import annotations
