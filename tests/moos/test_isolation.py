@@ -120,6 +120,7 @@ def test_good_clients_unaffected_by_slow_readers_and_partial_packets(tmp_path: P
             arrivals: dict[str, list[tuple[float, int]]] = {"SEQ_A": [], "SEQ_B": []}
             sent_at = [0.0] * PER_CLIENT
             peak = [rss_start]
+            late = [0.0]  # how late a 0.1 s sleep wakes up here: the machine's own stalls, not the DB's
             done = threading.Event()
 
             def receive(client, key: str) -> None:
@@ -130,7 +131,11 @@ def test_good_clients_unaffected_by_slow_readers_and_partial_packets(tmp_path: P
                     time.sleep(0.002)
 
             def sample() -> None:
-                while not done.wait(0.1):
+                while True:
+                    before = time.monotonic()
+                    if done.wait(0.1):
+                        return
+                    late[0] = max(late[0], time.monotonic() - before - 0.1)
                     peak[0] = max(peak[0], rss(pid))
 
             threads = [threading.Thread(target=receive, args=(bob, "SEQ_A")),
@@ -162,13 +167,16 @@ def test_good_clients_unaffected_by_slow_readers_and_partial_packets(tmp_path: P
             latency = [t - sent_at[n] for t, n in got]
             gaps = [b - a for a, b in zip(latency, latency[1:], strict=False)]
             worst[key] = max(gaps)
-            assert max(gaps) < 0.2, f"{key}: the DB held good messages back {max(gaps) * 1000:.0f} ms"
+            # On a loaded shared machine every process stalls now and then; such stalls (seen by a sleeper
+            # here) are added to the 200 ms bound, so only the DB's own hold-ups count (the were 6 s).
+            assert max(gaps) < 0.2 + late[0], \
+                f"{key}: the DB held good messages back {max(gaps) * 1000:.0f} ms (machine stalls {late[0] * 1000:.0f} ms)"
         assert attack.slow >= 10 and attack.partial >= 5
         assert "not keeping up: outbox full" in log and "slow" in log
         assert "max_buffered_bytes" in log and "partial" in log
         assert "pausing" not in log
         print(f"max gaps {[round(max(b[0] - a[0] for a, b in zip(g, g[1:], strict=False)) * 1000) for g in arrivals.values()]} ms "
-              f"(caused by the DB {[round(w * 1000) for w in worst.values()]} ms), "
+              f"(caused by the DB {[round(w * 1000) for w in worst.values()]} ms, machine stalls {late[0] * 1000:.0f} ms), "
               f"RSS {rss_start >> 20} -> peak {peak[0] >> 20} -> end {rss_end >> 20} MiB, slow {attack.slow}, partial {attack.partial}")
         assert peak[0] - rss_start < TOTAL_CAP + RSS_SLACK, (rss_start, peak[0])
         assert rss_end - rss_start < TOTAL_CAP, (rss_start, rss_end)  # given back: well under the cap
