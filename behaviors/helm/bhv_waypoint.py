@@ -143,8 +143,7 @@ class WaypointBehavior(CruiseSpeed, Behavior):
     def _post_wpt_flags(self, reached: Point, nxt: Point) -> None:
         """pHelmIvP 19.8.1's ``postWptFlags(x, y)``: ``$(X)``/``$(Y)`` (or ``$[X]``/``$[Y]``) are the waypoint just
         reached, ``$(NX)``/``$(NY)`` (or bracketed) the next one, at most 2 decimals; nothing else is expanded
-        (``$(PX)``, ``$(NI)``, ``$[OWNSHIP]``... post as written). Posted every time (repeatable). On completion
-        both are the last waypoint (19.8.1 posts the engine's point and leaves its next point as it was)."""
+        (``$(PX)``, ``$(NI)``, ``$[OWNSHIP]``... post as written). Posted every time (repeatable)."""
         xs, ys, nxs, nys = (fmt_num(v, 2) for v in (*reached, *nxt))
         macros = {"$(X)": xs, "$(Y)": ys, "$[X]": xs, "$[Y]": ys,
                   "$(NX)": nxs, "$(NY)": nys, "$[NX]": nxs, "$[NY]": nys}
@@ -180,10 +179,18 @@ class WaypointBehavior(CruiseSpeed, Behavior):
             for flag in self.cycle_flags:  # 19.8.1's postCycleFlags: posted as written, no macro expanded
                 if flag.condition is None or flag.condition.evaluate(self.info.get):
                     self.post(flag.var, flag.value({}), repeatable=True)
-        if (eng.target != this_pt or hit or (self.wptflag_on_start and not self._wpt_flag_published)
-                or result == "completed"):
+        if result == "completed":
+            # 19.8.1 posts twice on completion: setNextWaypoint with the engine's point after its reset (the
+            # first waypoint) and the next point left as it was (the last one), then onRunState with the
+            # waypoint just reached, because the engine's point moved.
+            self._post_wpt_flags(eng.target, this_pt)
+            if eng.target != this_pt:
+                self._prevpt = this_pt
+                self._post_wpt_flags(this_pt, this_pt)
+            self._wpt_flag_published = True
+        elif eng.target != this_pt or hit or (self.wptflag_on_start and not self._wpt_flag_published):
             self._prevpt = this_pt
-            self._post_wpt_flags(this_pt, this_pt if result == "completed" else eng.target)
+            self._post_wpt_flags(this_pt, eng.target)
             self._wpt_flag_published = True
         if eng.cycle_count != self._last_cycles and self.var_cycle.lower() != "silent":
             self.post(self.var_cycle + self.suffix, float(eng.cycle_count))

@@ -73,8 +73,8 @@ def test_waypoints_reached_in_order_then_endflags(tmp_path: Path) -> None:
     loop = CoreLoop(make_helm(tmp_path, WAYPOINTS, start_engaged="true"))
     loop.poke("DEPLOY", "true")
     assert loop.run(300, until=lambda: loop.values("RETURN"))
-    # on each advance (no wptflag_on_start) and at completion, where 19.8.1's next point is still the last one
-    assert loop.values("NEXT") == ["60,60", "60,0", "60,0"]
+    # on each advance (no wptflag_on_start) and twice at completion, where 19.8.1's next point is still the last one
+    assert loop.values("NEXT") == ["60,60", "60,0", "60,0", "60,0"]
     assert loop.values("WPT_INDEX") == [0.0, 1.0, 2.0]
     assert loop.values("SUMMARY") == ["speed=$[SPEED]"]  # 19.8.1 expands only OWNSHIP/BHVNAME/BHVTYPE/CONTACT
     assert loop.last("WPT_STAT") == "behavior-name=survey,completed"
