@@ -55,7 +55,11 @@ class Spec:
             return 8 * f.options["max_length"] + null
         if f.type == "message":
             return sum(spec.bits(value.get(spec.field.name)) for spec in self.children)
-        return ceil_log2(self.steps + 1 + null)
+        # DCCL's own arithmetic (DefaultNumericFieldCodec::size): floating-point noise in (max - min) / resolution
+        # can add a value: min 1.0, max 1.1, precision 1 takes 2 bits, as the C++ `dccl -a` reports
+        o = f.options
+        resolution = 10.0 ** -o["precision"] if "precision" in o else 1.0
+        return ceil_log2(math.ceil((o["max"] - o["min"]) / resolution + 1 + null))
 
     children: tuple[Spec, ...] = ()
 
