@@ -63,3 +63,21 @@ def scan_log_files(logs: Iterable[tuple[str, Path]]) -> list[str]:
 def scan_logs(processes: Iterable[ManagedProcess]) -> list[str]:
     """Unexpected error lines from every process log."""
     return scan_log_files((p.name, p.log_path) for p in processes)
+
+
+def ending_lines(outcomes: Iterable[ProcessOutcome], log_errors: list[str], failure: str | None,
+                 what: str = "processes") -> list[str]:
+    """The end of a mission summary: how the processes (or launchers) ended, error lines in their logs, failure."""
+    outcomes = list(outcomes)
+    clean = [o for o in outcomes if o.clean]
+    lines = [f"{what}: {len(clean)}/{len(outcomes)} exited cleanly"
+             + "".join(f"\n  NOT clean: {o.name} (exit status {o.returncode}, log {o.log_path})"
+                       for o in outcomes if not o.clean)]
+    if log_errors:
+        lines.append(f"unexpected error lines in the logs ({len(log_errors)}):")
+        lines.extend(f"  {line}" for line in log_errors[:20])
+    else:
+        lines.append("logs: no unexpected errors")
+    if failure:
+        lines.append(f"FAILED: {failure}")
+    return lines

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import statistics
 
+from launch.mission import ending_lines
 from launch.record import MissionRecord
 from launch.trail.analysis import (
     CommandOutcome,
@@ -102,15 +103,5 @@ def summary_text(result: TrailResult, trails: list[TrailPerformance], commands: 
         lines.append(f"  link statistics incomplete: {link_error}")
     for t, name, tail in result.deaths:
         lines.append(f"DIED at t={t:.0f} s: {name} (the others kept running); last lines of its log:\n{tail}")
-    clean = [o for o in result.outcomes if o.clean]
-    lines.append(f"launchers: {len(clean)}/{len(result.outcomes)} exited cleanly"
-                 + "".join(f"\n  NOT clean: {o.name} (exit status {o.returncode}, log {o.log_path})"
-                           for o in result.outcomes if not o.clean))
-    if result.log_errors:
-        lines.append(f"unexpected error lines in the logs ({len(result.log_errors)}):")
-        lines.extend(f"  {line}" for line in result.log_errors[:20])
-    else:
-        lines.append("logs: no unexpected errors")
-    if result.failure:
-        lines.append(f"FAILED: {result.failure}")
+    lines.extend(ending_lines(result.outcomes, result.log_errors, result.failure, "launchers"))
     return "\n".join(lines)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from launch.mission import ending_lines
 from launch.record import MissionRecord
 from launch.usv.analysis import (
     command_effects,
@@ -93,15 +94,5 @@ def summary_text(result: MissionResult, waypoints: list[Point]) -> str:
         final_heading = "" if last.heading is None else f" heading {normalized_heading(last.heading):.0f} deg"
         lines.append(f"track: {len(nav)} fixes over {last.t - nav[0].t:.0f} s, {distance:.0f} m travelled; "
                      f"last fix ({last.x:.0f},{last.y:.0f}){final_heading}")
-    clean = [o for o in result.outcomes if o.clean]
-    lines.append(f"processes: {len(clean)}/{len(result.outcomes)} exited cleanly"
-                 + "".join(f"\n  NOT clean: {o.name} (exit status {o.returncode}, log {o.log_path})"
-                           for o in result.outcomes if not o.clean))
-    if result.log_errors:
-        lines.append(f"unexpected error lines in the logs ({len(result.log_errors)}):")
-        lines.extend(f"  {line}" for line in result.log_errors[:20])
-    else:
-        lines.append("logs: no unexpected errors")
-    if result.failure:
-        lines.append(f"FAILED: {result.failure}")
+    lines.extend(ending_lines(result.outcomes, result.log_errors, result.failure, "processes"))
     return "\n".join(lines)
