@@ -5,14 +5,13 @@ from __future__ import annotations
 
 import contextlib
 import socket
-import struct
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 
 __all__ = ["IntervehicleClient", "LoopbackLink", "broker_config", "link_block", "link_brokers",
            "loopback_multicast_works", "random_multicast"]
 
-from gateway.goby.acomms.udp_multicast import random_multicast
+from gateway.goby.acomms.udp_multicast import join_multicast, random_multicast
 from gateway.goby.intervehicle.forwarder import InterVehicleForwarder
 from gateway.goby.portal.testing import BrokerProcess, PortalClient
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
@@ -21,13 +20,12 @@ from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConf
 def loopback_multicast_works(timeout_s: float = 1.0) -> bool:
     """True when a datagram sent to a multicast group on 127.0.0.1 comes back (the UDP multicast driver needs it)."""
     group, port = random_multicast()
-    rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+    try:
+        rx = join_multicast(group, port, interface="127.0.0.1")
+    except OSError:
+        return False
     tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
     try:
-        rx.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        rx.bind(("0.0.0.0", port))
-        rx.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
-                      struct.pack("4s4s", socket.inet_aton(group), socket.inet_aton("127.0.0.1")))
         tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton("127.0.0.1"))
         tx.sendto(b"probe", (group, port))
         rx.settimeout(timeout_s)
