@@ -11,13 +11,14 @@ import dataclasses
 import os
 import string
 import sys
-from collections.abc import Mapping
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, ClassVar, TypeVar
 
 from launch.errors import MissionConfigError
 
 T = TypeVar("T")
+S = TypeVar("S", bound="EnvSettings")
 
 INVALID_BANNER = "=============== INVALID CONFIGURATION ================="
 # Templates both missions render (app/interprocess blocks, broker, frontseat interface, gateway).
@@ -48,6 +49,38 @@ def fail(message: str) -> int:
     print(INVALID_BANNER, flush=True)
     print(f"invalid configuration: {message}", file=sys.stderr, flush=True)
     return 1
+
+
+def find_generator(generators: Mapping[str, T], app: str) -> T:
+    """The generator of ``app``'s configuration; MissionConfigError naming the known apps if there is none."""
+    try:
+        return generators[app]
+    except KeyError:
+        raise MissionConfigError(f"App: {app} not defined (known: {', '.join(sorted(generators))})") from None
+
+
+def make_dirs(run_dir: Path, *dirs: Path) -> None:
+    """Create the run directory and ``dirs`` (sockets, logs) if missing; MissionConfigError naming the run
+    directory if that fails."""
+    try:
+        for path in (run_dir, *dirs):
+            path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise MissionConfigError(f"cannot create the run directory {run_dir}: {exc.strerror or exc}") from exc
+
+
+def config_main(argv: list[str] | None, usage: str, nargs: int, generate: Callable[..., str]) -> int:
+    """A mission config module's ``main``: ``generate(*argv)`` (``nargs`` arguments, else ``usage``) printed to
+    stdout; a MissionConfigError is reported with ``fail``."""
+    args = sys.argv[1:] if argv is None else argv
+    if len(args) != nargs:
+        return fail(f"usage: {usage}")
+    try:
+        text = generate(*args)
+    except MissionConfigError as exc:
+        return fail(str(exc))
+    print(text, flush=True)
+    return 0
 
 
 def text_format_string(value: str) -> str:
@@ -81,3 +114,38 @@ def settings_from_env(cls: type[T], names: Mapping[str, str], environ: Mapping[s
         except ValueError as exc:
             raise MissionConfigError(f"{var}={raw!r} is not a valid {kind}") from exc
     return cls(**kwargs)
+
+
+def env_variables(prefix: str, fields: Iterable[str], **renamed: str) -> dict[str, str]:
+    """field -> environment variable: ``prefix`` and the field's name in capitals, unless ``renamed`` names it."""
+    return {name: renamed.get(name, prefix + name.upper()) for name in fields}
+
+
+class EnvSettings:
+    """A mission's frozen settings dataclass that travels to the launch lines as environment variables.
+
+    ``ENV`` (field -> variable) names the variables; the config generator run by each line rebuilds the same
+    settings with ``from_env``.
+    """
+
+    ENV: ClassVar[Mapping[str, str]]
+
+    def to_env(self) -> dict[str, str]:
+        """The variables that reproduce these settings in a launch line."""
+        return {var: str(getattr(self, name)) for name, var in self.ENV.items()}
+
+    @classmethod
+    def from_env(cls: type[S], environ: Mapping[str, str] | None = None) -> S:
+        """Settings from the variables; unset ones keep the defaults. Bad values raise MissionConfigError."""
+        return settings_from_env(cls, cls.ENV, environ)
+
+    def replace(self: S, **changes: object) -> S:
+        return dataclasses.replace(self, **changes)  # type: ignore[type-var, arg-type]
+
+
+def check_warp_and_origin(warp: int, lat_origin: float, lon_origin: float) -> None:
+    """MissionConfigError unless the warp is >= 1 and the origin a latitude,longitude."""
+    if warp < 1:
+        raise MissionConfigError(f"warp must be a whole number >= 1, not {warp}")
+    if not -90 <= lat_origin <= 90 or not -180 <= lon_origin <= 180:
+        raise MissionConfigError(f"origin {lat_origin},{lon_origin} is not a latitude,longitude")

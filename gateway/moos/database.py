@@ -10,23 +10,10 @@ from __future__ import annotations
 import logging
 import time as _time
 
+from . import message as msg_kinds
 from .clock import MoosClock
 from .codec import encode_message
-from .message import (
-    BINARY,
-    DOUBLE,
-    NOT_SET,
-    NOTIFY,
-    REGISTER,
-    SERVER_REQUEST,
-    STRING,
-    UNREGISTER,
-    WILDCARD_REGISTER,
-    WILDCARD_UNREGISTER,
-    MoosMessage,
-    to_bytes,
-    to_str,
-)
+from .message import BINARY, DOUBLE, NOT_SET, NOTIFY, STRING, MoosMessage, to_bytes, to_str
 from .wildcard import wild_match
 
 log = logging.getLogger(__name__)
@@ -158,19 +145,19 @@ class MoosDatabase:
         now = self.clock.time()
         for msg in messages:
             kind = msg.msg_type
-            if kind == NOTIFY:
+            if kind == NOTIFY:  # the common case first; the rest are rare (registrations, server requests)
                 self.notify(msg, now)
                 had_notify = True
-            elif kind == REGISTER:
+            elif kind == msg_kinds.REGISTER:
                 self.register(msg.raw_src, msg.raw_key, msg.dval)
-            elif kind == UNREGISTER:
+            elif kind == msg_kinds.UNREGISTER:
                 self.unregister(msg.raw_src, msg.raw_key)
-            elif kind == WILDCARD_REGISTER:
+            elif kind == msg_kinds.WILDCARD_REGISTER:
                 self.wildcard_register(msg.raw_src, *parse_filter(msg.raw_sval))
-            elif kind == WILDCARD_UNREGISTER:
+            elif kind == msg_kinds.WILDCARD_UNREGISTER:
                 app, var, _ = parse_filter(msg.raw_sval)
                 self.wildcard_unregister(msg.raw_src, app, var)
-            elif kind == SERVER_REQUEST:
+            elif kind == msg_kinds.SERVER_REQUEST:
                 replies[:0] = self.server_request(msg)
         self.maybe_publish_summaries(now)
         return replies, had_notify

@@ -20,7 +20,14 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-from launch.config import SHARED_TEMPLATES, fail, render, text_format_string
+from launch.config import (
+    SHARED_TEMPLATES,
+    config_main,
+    find_generator,
+    make_dirs,
+    render,
+    text_format_string,
+)
 from launch.errors import MissionConfigError
 from launch.trail.settings import (
     MULTICAST_ADDRESS,
@@ -260,32 +267,16 @@ GENERATORS: dict[str, Callable[[TrailSettings, Vehicle], str]] = {
 
 def generate(platform: str, app: str, settings: TrailSettings, vehicle: Vehicle | None = None) -> str:
     """One app's configuration text; MissionConfigError for an unknown app, a bad setting or a missing variable."""
-    name = ALIASES.get(app, app)
-    try:
-        generator = GENERATORS[name]
-    except KeyError:
-        raise MissionConfigError(f"App: {app} not defined (known: {', '.join(sorted(GENERATORS))})") from None
+    generator = find_generator(GENERATORS, ALIASES.get(app, app))
     vehicle = vehicle or vehicle_from_env(platform)
-    try:
-        settings.run_dir.mkdir(parents=True, exist_ok=True)
-        settings.sockets.mkdir(parents=True, exist_ok=True)
-        vehicle.log_dir(settings).mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise MissionConfigError(f"cannot create the run directory {settings.run_dir}: {exc.strerror or exc}") from exc
+    make_dirs(settings.run_dir, settings.sockets, vehicle.log_dir(settings))
     return generator(settings, vehicle)
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = sys.argv[1:] if argv is None else argv
-    if len(args) != 2:
-        return fail(f"usage: python -m launch.trail.config PLATFORM APP   (PLATFORM topside|usv|auv; APP one of "
-                    f"{', '.join(sorted(GENERATORS))})")
-    try:
-        text = generate(args[0], args[1], TrailSettings.from_env())
-    except MissionConfigError as exc:
-        return fail(str(exc))
-    print(text, flush=True)
-    return 0
+    return config_main(argv, f"python -m launch.trail.config PLATFORM APP   (PLATFORM topside|usv|auv; APP one of "
+                       f"{', '.join(sorted(GENERATORS))})", 2,
+                       lambda platform, app: generate(platform, app, TrailSettings.from_env()))
 
 
 if __name__ == "__main__":

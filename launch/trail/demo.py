@@ -10,17 +10,14 @@ prints a summary. Exit status 0 only if the mission ran and every process stoppe
 from __future__ import annotations
 
 import argparse
-import contextlib
 import csv
 import logging
-import shutil
 import sys
-import tempfile
 import time
 from collections import Counter
 from pathlib import Path
 
-from launch.errors import LaunchError, MissionConfigError
+from launch.demo import add_run_arguments, demo_main, fresh_run_dir, run_mission, schedule_type, whole_number
 from launch.mission import choose_program
 from launch.record import MissionRecord, shifted
 from launch.trail.analysis import command_outcomes, recover_outcome, trail_performance
@@ -30,8 +27,7 @@ from launch.trail.operator import SCHEDULE_HELP, Operator, PortalWorker, parse_t
 from launch.trail.plot import write_trail_png
 from launch.trail.settings import TrailSettings, Vehicle
 from launch.trail.summary import progress_line, summary_text
-from util.logsetup import add_verbosity_argument, configure_logging
-from util.process import handle_signals
+from util.logsetup import add_verbosity_argument
 
 log = logging.getLogger(__name__)
 
@@ -42,32 +38,9 @@ DEFAULT_SCHEDULE = {"ivp": "0:polygon:6:200,500:waypoints,1000:recover", "goby":
 MAX_SOCKET_BASE = 80  # AF_UNIX paths are limited to ~107 bytes
 
 
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, not {value}")
-    return value
-
-
-def _auvs(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if not 0 <= value <= 64:
-        raise argparse.ArgumentTypeError(f"must be 0..64, not {value}")
-    return value
-
-
-def _schedule(text: str) -> str:
-    try:
-        parse_trail_schedule(text)
-    except MissionConfigError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-    return text
+_positive_int = whole_number(1)
+_auvs = whole_number(0, 64)
+_schedule = schedule_type(parse_trail_schedule)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -84,11 +57,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help=f"{SCHEDULE_HELP} (default {DEFAULT_SCHEDULE['ivp']}; none with --usv-helm goby)")
     parser.add_argument("--east-duration", type=_positive_int, default=500, help="homework helm: east leg, s")
     parser.add_argument("--south-duration", type=_positive_int, default=200, help="homework helm: south leg, s")
-    parser.add_argument("--out", type=Path, default=Path("out"), help="output directory (default ./out)")
-    parser.add_argument("--moosdb", choices=("auto", "real", "ours"), default="auto",
-                        help="MOOSDB when on PATH (auto), force it (real) or our moos-db (ours)")
-    parser.add_argument("--helm", choices=("auto", "real", "ours"), default="auto",
-                        help="pHelmIvP when on PATH (auto), force it (real) or our ivp-helm (ours)")
+    add_run_arguments(parser)
     parser.add_argument("--listen", default="127.0.0.1", metavar="ADDRESS",
                         help="address the liaison pages listen on (default 127.0.0.1). RISK: another address lets "
                         "anyone who can reach it watch all traffic and command the vehicles: the pages have no login")
@@ -177,10 +146,7 @@ def _report(line: str) -> None:
 
 def run_demo(args: argparse.Namespace) -> int:
     out: Path = args.out.resolve()
-    run_dir = out / "run"
-    if run_dir.exists():
-        shutil.rmtree(run_dir)
-    socket_dir = run_dir if len(str(run_dir)) < MAX_SOCKET_BASE else Path(tempfile.mkdtemp(prefix="trail-", dir="/tmp"))
+    run_dir, socket_dir = fresh_run_dir(out, "trail-", MAX_SOCKET_BASE)
     settings = make_settings(args, run_dir, socket_dir)
     schedule = args.schedule if args.schedule is not None else DEFAULT_SCHEDULE[args.usv_helm]
     plan = parse_trail_schedule(schedule)
@@ -194,18 +160,17 @@ def run_demo(args: argparse.Namespace) -> int:
     mission.add_hook(links.poll)
     operator_record = MissionRecord()
     workers: list[PortalWorker] = []
-    signals = contextlib.ExitStack()  # SIGINT/SIGTERM stop the mission; the previous handlers come back in `finally`
-    signals.enter_context(handle_signals(lambda _signum: mission.stop_event.set()))
-    failure = None
     started = time.monotonic()
     sim_seconds = 0.0
-    try:
+
+    def body() -> None:
+        nonlocal sim_seconds
         print(f"starting {len(mission.entries)} platforms ...", flush=True)
         mission.start()
         print(liaison_urls_line(settings, n), flush=True)
         topside = PortalWorker("topside", Vehicle("topside", n).ipc_base(settings), settings.warp)
         usv = PortalWorker("usv", Vehicle("usv", n).ipc_base(settings), settings.warp) if args.usv_helm == "ivp" else None
-        workers = [w for w in (topside, usv) if w is not None]
+        workers.extend(w for w in (topside, usv) if w is not None)
         for worker in workers:
             worker.start()
         topside.watch_node_status(operator_record, mission.clock)
@@ -221,18 +186,14 @@ def run_demo(args: argparse.Namespace) -> int:
             mission.run(duration, lambda t: print(progress_line({k: r.record for k, r in mission.runs.items()}, t,
                                                                 duration), flush=True))
             sim_seconds = mission.now() - t0
-    except LaunchError as exc:
-        failure = str(exc)
-        print(f"demo: {exc}", file=sys.stderr, flush=True)
-    finally:
+
+    def close_workers_and_links() -> None:
         for worker in workers:
             worker.close()
         links.poll()
         links.close()
-        result = mission.stop(failure)
-        signals.close()
-        if socket_dir != run_dir:
-            shutil.rmtree(socket_dir, ignore_errors=True)
+
+    result, failure = run_mission(mission, body, run_dir, socket_dir, before_stop=close_workers_and_links)
     title = (f"Trail mission: USV ({args.usv_helm} helm) + {n} AUVs, {settings.helm} + {settings.moosdb}, "
              f"warp {settings.warp}, {sim_seconds:.0f} sim s")
     print(report(result, operator_record, n, links, sim_seconds, out, title), flush=True)
@@ -244,13 +205,7 @@ def run_demo(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    configure_logging(args.verbose, "trail-demo")
-    try:
-        return run_demo(args)
-    except LaunchError as exc:
-        print(f"demo: {exc}", file=sys.stderr)
-        return 1
+    return demo_main(build_parser(), run_demo, "trail-demo", argv)
 
 
 if __name__ == "__main__":

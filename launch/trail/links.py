@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import logging
 import socket
-import struct
 import time
 from collections import Counter
 from dataclasses import dataclass, field
@@ -19,6 +18,7 @@ from dataclasses import dataclass, field
 from google.protobuf.message import DecodeError
 
 from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
+from gateway.goby.acomms.udp_multicast import join_multicast
 from launch.trail.settings import MULTICAST_ADDRESS, TrailSettings, acomms_mac_slots, satellite_mac_slots
 
 log = logging.getLogger(__name__)
@@ -113,14 +113,6 @@ def _count(stats: LinkStats, datagram: bytes) -> None:
 
 def _listen(group: str, port: int) -> socket.socket:
     """A non-blocking UDP socket joined to ``group:port`` (as the modem driver's, without sending)."""
-    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
-    try:
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        sock.bind(("0.0.0.0", port))
-        sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
-                        struct.pack("4s4s", socket.inet_aton(group), socket.inet_aton("0.0.0.0")))
-        sock.setblocking(False)
-    except OSError:
-        sock.close()
-        raise
+    sock = join_multicast(group, port)
+    sock.setblocking(False)
     return sock

@@ -14,13 +14,13 @@ modem id+1+256 under subnet mask 0xFF00; acomms TDMA slots alternating USV (258)
 
 from __future__ import annotations
 
-import dataclasses
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
-from launch.config import settings_from_env
+from launch.config import EnvSettings, check_warp_and_origin, env_variables
 from launch.errors import MissionConfigError
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -44,30 +44,17 @@ MULTICAST_ADDRESS = "239.142.0.2"
 # The topside's default plan (sim seconds after the USV is under helm command): polygon, then waypoints.
 DEFAULT_SCHEDULE = "0:polygon:6:200,400:waypoints"
 
-_ENV = {
-    "run_dir": "TRAIL_RUN_DIR",
-    "warp": "TRAIL_WARP",
-    "lat_origin": "TRAIL_LAT_ORIGIN",
-    "lon_origin": "TRAIL_LON_ORIGIN",
-    "moos_port_base": "TRAIL_MOOS_PORT_BASE",
-    "sim_port_base": "TRAIL_SIM_PORT_BASE",
-    "liaison_port_base": "TRAIL_LIAISON_PORT_BASE",
-    "satellite_port": "TRAIL_SATELLITE_PORT",
-    "acomms_port": "TRAIL_ACOMMS_PORT",
-    "moosdb": "TRAIL_MOOSDB",
-    "helm": "TRAIL_HELM",
-    "usv_helm": "TRAIL_USV_HELM",
-    "liaison_address": "TRAIL_LIAISON_ADDRESS",
-    "schedule": "TRAIL_SCHEDULE",
-    "socket_dir": "TRAIL_SOCKET_DIR",
-    "east_duration": "TRAIL_EAST_DURATION",
-    "south_duration": "TRAIL_SOUTH_DURATION",
-}
+_ENV = env_variables("TRAIL_", (
+    "run_dir", "warp", "lat_origin", "lon_origin", "moos_port_base", "sim_port_base", "liaison_port_base",
+    "satellite_port", "acomms_port", "moosdb", "helm", "usv_helm", "liaison_address", "schedule", "socket_dir",
+    "east_duration", "south_duration"))
 
 
 @dataclass(frozen=True)
-class TrailSettings:
+class TrailSettings(EnvSettings):
     """What every process of every platform must agree on: warp, origin, port bases, program choices."""
+
+    ENV: ClassVar[Mapping[str, str]] = _ENV
 
     run_dir: Path = Path("/tmp/goby3_course_trail")
     warp: int = 5  # common/sim.py
@@ -88,27 +75,13 @@ class TrailSettings:
     south_duration: int = 200
 
     def __post_init__(self) -> None:
-        if self.warp < 1:
-            raise MissionConfigError(f"warp must be a whole number >= 1, not {self.warp}")
+        check_warp_and_origin(self.warp, self.lat_origin, self.lon_origin)
         if self.usv_helm not in ("ivp", "goby"):
             raise MissionConfigError(f"TRAIL_USV_HELM must be ivp or goby, not {self.usv_helm!r}")
         for name in ("moos_port_base", "sim_port_base", "liaison_port_base", "satellite_port", "acomms_port"):
             port = getattr(self, name)
             if not 0 < port < 65536 - 256:
                 raise MissionConfigError(f"{name} {port} is not a TCP/UDP port with room for 256 vehicles")
-        if not -90 <= self.lat_origin <= 90 or not -180 <= self.lon_origin <= 180:
-            raise MissionConfigError(f"origin {self.lat_origin},{self.lon_origin} is not a latitude,longitude")
-
-    def to_env(self) -> dict[str, str]:
-        """The ``TRAIL_*`` variables that reproduce these settings in a launch line."""
-        return {var: str(getattr(self, name)) for name, var in _ENV.items()}
-
-    @classmethod
-    def from_env(cls, environ: Mapping[str, str] | None = None) -> TrailSettings:
-        return settings_from_env(cls, _ENV, environ)
-
-    def replace(self, **changes: object) -> TrailSettings:
-        return dataclasses.replace(self, **changes)  # type: ignore[arg-type]
 
     @property
     def sockets(self) -> Path:

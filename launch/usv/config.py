@@ -14,7 +14,7 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-from launch.config import SHARED_TEMPLATES, fail, render, text_format_string
+from launch.config import SHARED_TEMPLATES, config_main, find_generator, make_dirs, render, text_format_string
 from launch.errors import MissionConfigError
 from launch.usv.analysis import bhv_loiter_polygon, bhv_waypoints
 from launch.usv.settings import USV_DIR, UsvSettings
@@ -152,30 +152,15 @@ GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
 
 def generate(app: str, settings: UsvSettings) -> str:
     """One app's configuration text; MissionConfigError for an unknown app or a bad setting."""
-    try:
-        generator = GENERATORS[app]
-    except KeyError:
-        raise MissionConfigError(f"App: {app} not defined (known: {', '.join(sorted(GENERATORS))})") from None
+    generator = find_generator(GENERATORS, app)
     # The run directory holds the broker's sockets and the .moos file: make sure it exists whichever app comes first.
-    try:
-        settings.run_dir.mkdir(parents=True, exist_ok=True)
-        Path(settings.ipc_base).parent.mkdir(parents=True, exist_ok=True)
-        Path(settings.topside_ipc_base).parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise MissionConfigError(f"cannot create the run directory {settings.run_dir}: {exc.strerror or exc}") from exc
+    make_dirs(settings.run_dir, Path(settings.ipc_base).parent, Path(settings.topside_ipc_base).parent)
     return generator(settings)
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = sys.argv[1:] if argv is None else argv
-    if len(args) != 1:
-        return fail(f"usage: python -m launch.usv.config APP   (APP one of {', '.join(sorted(GENERATORS))})")
-    try:
-        text = generate(args[0], UsvSettings.from_env())
-    except MissionConfigError as exc:
-        return fail(str(exc))
-    print(text, flush=True)
-    return 0
+    return config_main(argv, f"python -m launch.usv.config APP   (APP one of {', '.join(sorted(GENERATORS))})", 1,
+                       lambda app: generate(app, UsvSettings.from_env()))
 
 
 if __name__ == "__main__":

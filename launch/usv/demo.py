@@ -11,27 +11,25 @@ stopped cleanly.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import logging
 import math
 import shlex
 import shutil
 import socket
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 from gateway.goby.acomms.udp_multicast import random_multicast
-from launch.errors import LaunchError, MissionConfigError
+from launch.demo import add_run_arguments, demo_main, fresh_run_dir, run_mission, schedule_type, whole_number
 from launch.usv.analysis import bhv_waypoints, command_effects, loiter_phases, transitions
 from launch.usv.mission import MissionResult, UsvMission, choose_program, liaison_page_urls
 from launch.usv.plot import write_track_png
 from launch.usv.settings import DEFAULT_SCHEDULE, KAUAI_ORIGIN, UsvSettings
 from launch.usv.shore import SCHEDULE_HELP, parse_schedule
 from launch.usv.summary import progress_line, summary_text
-from util.logsetup import add_verbosity_argument, configure_logging
-from util.process import free_port, handle_signals
+from util.logsetup import add_verbosity_argument
+from util.process import free_port
 
 log = logging.getLogger(__name__)
 
@@ -40,14 +38,7 @@ DEFAULT_WARP = 20
 MAX_SOCKET_BASE = 90  # AF_UNIX paths are limited to ~107 bytes
 
 
-def _warp(text: str) -> int:
-    try:
-        warp = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if warp < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, not {warp}")
-    return warp
+_warp = whole_number(1)
 
 
 def _origin(text: str) -> tuple[float, float]:
@@ -62,13 +53,8 @@ def _origin(text: str) -> tuple[float, float]:
     return lat, lon
 
 
-def _schedule(text: str) -> str:
-    """The shore's own parser, so a schedule the shore would refuse is refused before anything starts."""
-    try:
-        parse_schedule(text)
-    except MissionConfigError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-    return text
+# The shore's own parser, so a schedule the shore would refuse is refused before anything starts.
+_schedule = schedule_type(parse_schedule)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -78,11 +64,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "0 = until Ctrl-C)")
     parser.add_argument("--forever", action="store_true", help="run until Ctrl-C or SIGTERM (same as --duration 0)")
     parser.add_argument("--warp", type=_warp, default=DEFAULT_WARP, help=f"time warp (default {DEFAULT_WARP})")
-    parser.add_argument("--out", type=Path, default=Path("out"), help="output directory (default ./out)")
-    parser.add_argument("--moosdb", choices=("auto", "real", "ours"), default="auto",
-                        help="MOOSDB when on PATH (auto), force it (real) or our moos-db (ours)")
-    parser.add_argument("--helm", choices=("auto", "real", "ours"), default="auto",
-                        help="pHelmIvP when on PATH (auto), force it (real) or our ivp-helm (ours)")
+    add_run_arguments(parser)
     parser.add_argument("--schedule", type=_schedule, default=DEFAULT_SCHEDULE,
                         help=f"shore commands: {SCHEDULE_HELP} (default {DEFAULT_SCHEDULE})")
     parser.add_argument("--origin", type=_origin, default=f"{KAUAI_ORIGIN[0]},{KAUAI_ORIGIN[1]}", metavar="LAT,LON",
@@ -185,10 +167,7 @@ def write_outputs(result: MissionResult, settings: UsvSettings, out: Path) -> tu
 
 def run_demo(args: argparse.Namespace) -> int:
     out: Path = args.out.resolve()
-    run_dir = out / "run"
-    if run_dir.exists():
-        shutil.rmtree(run_dir)
-    socket_dir = run_dir if len(str(run_dir)) < MAX_SOCKET_BASE else Path(tempfile.mkdtemp(prefix="usv-", dir="/tmp"))
+    run_dir, socket_dir = fresh_run_dir(out, "usv-", MAX_SOCKET_BASE)
     settings = make_settings(args, run_dir, socket_dir)
     duration = args.duration if args.duration > 0 and not args.forever else None
     planned = len(parse_schedule(settings.schedule))
@@ -197,11 +176,9 @@ def run_demo(args: argparse.Namespace) -> int:
     print(f"shore schedule: {settings.schedule}" + ("" if planned else " (no commands: send them from the "
                                                       "commander page or with usv-command)"), flush=True)
     mission = UsvMission(settings)
-    signals = contextlib.ExitStack()  # SIGINT/SIGTERM stop the mission; the previous handlers come back in `finally`
-    signals.enter_context(handle_signals(lambda _signum: mission.stop_event.set()))
-    failure = None
     started = time.monotonic()
-    try:
+
+    def body() -> None:
         mission.start()
         print("waiting for the frontseat interface to reach COMMAND ...", flush=True)
         urls = mission.liaison_urls()
@@ -218,14 +195,8 @@ def run_demo(args: argparse.Namespace) -> int:
                   "or, in another terminal (bash):\n"
                   + "\n".join(f"  {line}" for line in command_lines(settings)), flush=True)
         mission.run(duration, lambda t: print(progress_line(mission.record, t, duration), flush=True))
-    except LaunchError as exc:
-        failure = str(exc)
-        print(f"demo: {exc}", file=sys.stderr, flush=True)
-    finally:
-        result = mission.stop(failure)
-        signals.close()
-        if socket_dir != run_dir:
-            shutil.rmtree(socket_dir, ignore_errors=True)
+
+    result, failure = run_mission(mission, body, run_dir, socket_dir)
     out.mkdir(parents=True, exist_ok=True)
     track_csv, png = write_outputs(result, settings, out)
     print(summary_text(result, bhv_waypoints(settings.bhv_file)), flush=True)
@@ -235,13 +206,7 @@ def run_demo(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    configure_logging(args.verbose, "usv-demo")
-    try:
-        return run_demo(args)
-    except LaunchError as exc:
-        print(f"demo: {exc}", file=sys.stderr)
-        return 1
+    return demo_main(build_parser(), run_demo, "usv-demo", argv)
 
 
 if __name__ == "__main__":

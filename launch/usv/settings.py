@@ -8,12 +8,12 @@ simulator port 55000+id, the Kauai origin, platform ``usv``.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
-from launch.config import settings_from_env
+from launch.config import EnvSettings, check_warp_and_origin, env_variables
 from launch.errors import MissionConfigError
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -24,31 +24,17 @@ BUZZARDS_BAY_ORIGIN = (41.592344, -70.711260)
 # The shore script's default plan: (sim seconds after the vehicle is under helm command, command).
 DEFAULT_SCHEDULE = "0:polygon:6:200,500:waypoints,800:polygon:8:400"
 
-_ENV = {
-    "run_dir": "USV_RUN_DIR",
-    "warp": "USV_WARP",
-    "lat_origin": "USV_LAT_ORIGIN",
-    "lon_origin": "USV_LON_ORIGIN",
-    "platform": "USV_PLATFORM",
-    "community": "USV_COMMUNITY",
-    "vehicle_id": "USV_VEHICLE_ID",
-    "moos_port": "USV_MOOS_PORT",
-    "sim_port": "USV_SIM_PORT",
-    "moosdb": "USV_MOOSDB",
-    "helm": "USV_HELM",
-    "bhv_file": "USV_BHV_FILE",
-    "schedule": "USV_SHORE_SCHEDULE",
-    "socket_name": "USV_SOCKET_NAME",
-    "liaison_address": "USV_LIAISON_ADDRESS",
-    "liaison_port": "USV_LIAISON_PORT",
-    "topside_liaison_port": "USV_TOPSIDE_LIAISON_PORT",
-    "sat_port": "USV_SAT_PORT",
-}
+_ENV = env_variables("USV_", (
+    "run_dir", "warp", "lat_origin", "lon_origin", "platform", "community", "vehicle_id", "moos_port", "sim_port",
+    "moosdb", "helm", "bhv_file", "schedule", "socket_name", "liaison_address", "liaison_port",
+    "topside_liaison_port", "sat_port"), schedule="USV_SHORE_SCHEDULE")
 
 
 @dataclass(frozen=True)
-class UsvSettings:
+class UsvSettings(EnvSettings):
     """Everything two processes must agree on: time warp, origin, ports, names, file places."""
+
+    ENV: ClassVar[Mapping[str, str]] = _ENV
 
     run_dir: Path = Path("/tmp/usv_mission")
     warp: int = 20
@@ -71,14 +57,11 @@ class UsvSettings:
     topside_platform: str = "topside"  # the shore's own broker (satellite modem 1)
 
     def __post_init__(self) -> None:
-        if self.warp < 1:
-            raise MissionConfigError(f"warp must be a whole number >= 1, not {self.warp}")
+        check_warp_and_origin(self.warp, self.lat_origin, self.lon_origin)
         for port_name in ("moos_port", "sim_port", "liaison_port", "sat_port", "topside_liaison_port"):
             port = getattr(self, port_name)
             if not 0 < port < 65536 and not (port == 0 and port_name == "topside_liaison_port"):
                 raise MissionConfigError(f"{port_name} {port} is not a TCP port")
-        if not -90 <= self.lat_origin <= 90 or not -180 <= self.lon_origin <= 180:
-            raise MissionConfigError(f"origin {self.lat_origin},{self.lon_origin} is not a latitude,longitude")
 
     @property
     def ipc_base(self) -> str:
@@ -107,14 +90,3 @@ class UsvSettings:
     def log_dir(self) -> Path:
         return self.run_dir / "logs"
 
-    def to_env(self) -> dict[str, str]:
-        """The ``USV_*`` environment variables that reproduce these settings in a launch line."""
-        return {var: str(getattr(self, field)) for field, var in _ENV.items()}
-
-    @classmethod
-    def from_env(cls, environ: Mapping[str, str] | None = None) -> UsvSettings:
-        """Settings from ``USV_*`` variables; unset ones keep the defaults. Bad values raise MissionConfigError."""
-        return settings_from_env(cls, _ENV, environ)
-
-    def replace(self, **changes: object) -> UsvSettings:
-        return dataclasses.replace(self, **changes)  # type: ignore[arg-type]

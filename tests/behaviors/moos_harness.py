@@ -23,6 +23,14 @@ WARP = 20.0
 REPO = Path(__file__).resolve().parents[2]
 IVP_HELM = Path(sys.executable).parent / "ivp-helm"
 
+def bhv_block(kind: str, **params: object) -> str:
+    """One ``Behavior = BHV_<kind> { ... }`` block of a .bhv file: ``params`` in order, then ``duration =
+    no-time-limit`` unless a duration is given."""
+    params.setdefault("duration", "no-time-limit")
+    lines = "".join(f"  {name:<8} = {value}\n" for name, value in params.items())
+    return f"Behavior = BHV_{kind}\n{{\n{lines}}}\n"
+
+
 def write_mission(tmp_path: Path, port: int, bhv: Path, warp: float = WARP, community: str = "alpha",
                   max_speed: str = "2", extra: str = "", app_tick: float = 4, blocks: str = "",
                   name: str = "mission.moos") -> Path:

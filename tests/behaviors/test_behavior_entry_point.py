@@ -14,23 +14,10 @@ from behaviors.helm.testing import helm_from_text
 from gateway.moos import MoosClock
 from gateway.moos.testing import running_moosdb
 
-from .moos_harness import WARP, helm_process, observer, write_mission
+from .moos_harness import WARP, bhv_block, helm_process, observer, write_mission
 
 DISTRIBUTION = Path(__file__).with_name("pulse_distribution")
-PULSE_BHV = """\
-Behavior = BHV_Pulse
-{
-  name     = pulse
-  speed    = 1.25
-  duration = no-time-limit
-}
-Behavior = BHV_ConstantHeading
-{
-  name     = steer
-  heading  = 45
-  duration = no-time-limit
-}
-"""
+PULSE_BHV = bhv_block("Pulse", name="pulse", speed=1.25) + bhv_block("ConstantHeading", name="steer", heading=45)
 WATCH = ["PULSE_COUNT", "DESIRED_SPEED", "DESIRED_HEADING", "IVPHELM_STATE", "BHV_ERROR"]
 
 

@@ -11,19 +11,14 @@ import pytest
 from gateway.goby.intervehicle import Publisher, Subscriber, TransporterConfig
 from gateway.goby.intervehicle import groups as iv_groups
 from gateway.goby.intervehicle.protobuf.intervehicle_pb2 import ModemTransmissionWithLinkID
-from gateway.goby.intervehicle.testing import (
-    IntervehicleClient,
-    broker_config,
-    link_block,
-    loopback_multicast_works,
-    random_multicast,
-)
+from gateway.goby.intervehicle.testing import IntervehicleClient, LoopbackLink, link_brokers
 from gateway.goby.portal import Group
-from gateway.goby.portal.testing import BrokerProcess
+from gateway.goby.portal.testing import poll_all
+from tests.markers import needs_loopback_multicast
 from translators.trail.protobuf.nav_dccl_pb2 import NavigationReport
 from translators.usv.protobuf.command_dccl_pb2 import AUVCommand
 
-pytestmark = pytest.mark.skipif(not loopback_multicast_works(), reason="multicast on 127.0.0.1 is not available here")
+pytestmark = needs_loopback_multicast
 
 WARP = 20
 USV, AUV1, AUV2 = 258, 259, 260
@@ -46,35 +41,17 @@ def nav(x: float) -> NavigationReport:
 
 @pytest.fixture
 def fleet(tmp_path):
-    group, port = random_multicast()
-    brokers = []
-    try:
-        for name, modem in (("usv", USV), ("auv1", AUV1), ("auv2", AUV2)):
-            cfg = tmp_path / f"{name}.pb.cfg"
-            cfg.write_text(broker_config([link_block(modem, group, port, SLOTS)], warp=WARP))
-            brokers.append(BrokerProcess(tmp_path, platform=f"iv_{name}", extra_args=[str(cfg)],
-                                         log_path=tmp_path / f"{name}.log").start())
-        clients = [IntervehicleClient(b.interprocess_config(), name=f"app_{b.platform}") for b in brokers]
+    acomms = LoopbackLink(SLOTS)
+    links = {name: [acomms.block(modem)] for name, modem in (("usv", USV), ("auv1", AUV1), ("auv2", AUV2))}
+    with link_brokers(tmp_path, links, "iv", warp=WARP) as brokers:
+        clients = [IntervehicleClient(b.interprocess_config(), name=f"app_{b.platform}") for b in brokers.values()]
         try:
             for c in clients:
                 assert c.wait_subscribed()
-            yield brokers, clients
+            yield list(brokers.values()), clients
         finally:
             for c in clients:
                 c.close()
-    finally:
-        for b in brokers:
-            b.stop()
-
-
-def poll_all(clients, predicate, timeout_s: float) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        for c in clients:
-            c.poll(0.01)
-        if predicate():
-            return True
-    return False
 
 
 def test_three_vehicles_on_the_acomms_link(fleet) -> None:

@@ -11,12 +11,7 @@ import aiohttp
 import pytest
 from google.protobuf import text_format
 
-from gateway.goby.intervehicle.testing import (
-    broker_config,
-    link_block,
-    loopback_multicast_works,
-    random_multicast,
-)
+from gateway.goby.intervehicle.testing import broker_config, link_block, random_multicast
 from gateway.goby.portal.testing import broker_process, running_app
 from launch.liaison.portal_side import LiaisonApp
 from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
@@ -25,18 +20,13 @@ from launch.liaison.testing import browser_skip_reason, chromium
 from launch.trail.config import generate as trail_generate
 from launch.trail.demo import liaison_urls_line
 from launch.trail.settings import TrailSettings, Vehicle
-from tests.liaison.test_server import receive_until, ws_url
+from tests.liaison.test_server import COMMANDER_CONFIG_HEAD, receive_until, ws_url
+from tests.markers import needs_loopback_multicast
 from util.process import free_port, wait_until
 
-pytestmark = pytest.mark.skipif(not loopback_multicast_works(), reason="multicast on 127.0.0.1 is not available here")
+pytestmark = needs_loopback_multicast
 
-CONFIG = """
-http_address: "127.0.0.1"
-http_port: {port}
-update_freq: 20
-load_shared_library: "libgoby3_course_messages.so"
-pb_commander_config {{
-  load_protobuf {{ name: "goby3_course.dccl.USVCommand"
+CONFIG = COMMANDER_CONFIG_HEAD + """\
                    publish_to {{ group: "usv_command" group_numeric: 0 layer: LAYER_INTERVEHICLE }} }}
 }}
 """

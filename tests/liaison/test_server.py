@@ -20,13 +20,16 @@ from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from util.process import free_port
 
-CONFIG = """
+# How every test's config begins: the page on loopback, the course's messages, the Commander's USVCommand.
+COMMANDER_CONFIG_HEAD = """
 http_address: "127.0.0.1"
 http_port: {port}
 update_freq: 20
 load_shared_library: "libgoby3_course_messages.so"
 pb_commander_config {{
   load_protobuf {{ name: "goby3_course.dccl.USVCommand"
+"""
+CONFIG = COMMANDER_CONFIG_HEAD + """\
                    publish_to {{ group: "goby3_course::shore::usv_command;0" layer: LAYER_INTERPROCESS }} }}
   notify_subscribe {{ type_regex: ".*USVCommandAck" group_regex: ".*" }}
 }}

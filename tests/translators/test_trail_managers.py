@@ -18,23 +18,19 @@ from translator_procs import ORIGIN, running
 from frontseat import groups as frontseat_groups
 from frontseat.protobuf import frontseat_data_pb2 as fs
 from frontseat.protobuf.frontseat_data_pb2 import DesiredCourse, NodeStatus
-from gateway.goby.intervehicle.testing import (
-    broker_config,
-    link_block,
-    loopback_multicast_works,
-    random_multicast,
-)
+from gateway.goby.intervehicle.testing import LoopbackLink, link_brokers
 from gateway.goby.portal.testing import BrokerProcess, PortalClient
 from gateway.goby.portal.timeutil import SystemClock
 from gateway.moos.message import MoosMessage
 from gateway.moos.testing import connected_comms, moosdb_process
+from tests.markers import needs_loopback_multicast
 from translators.testing import GatewayProcess
 from translators.trail import groups
 from translators.usv.protobuf.command_dccl_pb2 import AUVCommand
 from util.geodesy import UTMGeodesy
 from util.process import ChildProcess
 
-pytestmark = pytest.mark.skipif(not loopback_multicast_works(), reason="multicast on 127.0.0.1 is not available here")
+pytestmark = needs_loopback_multicast
 
 WARP = 10
 TOPSIDE_SAT, USV_SAT, USV_ACOMMS, AUV_ACOMMS = 1, 2, 258, 259  # the course's modem ids (AUV 0 has vehicle id 2)
@@ -84,18 +80,11 @@ class Fleet:
 @pytest.fixture(scope="module")
 def fleet(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Fleet]:
     workdir = tmp_path_factory.mktemp("trail_fleet")
-    sat, acomms = random_multicast(), random_multicast()
-    sat_link = lambda modem: link_block(modem, *sat, SAT_SLOTS)  # noqa: E731
-    acomms_link = lambda modem: link_block(modem, *acomms, ACOMMS_SLOTS)  # noqa: E731
+    sat, acomms = LoopbackLink(SAT_SLOTS), LoopbackLink(ACOMMS_SLOTS)
+    links = {"topside": [sat.block(TOPSIDE_SAT)], "usv": [sat.block(USV_SAT), acomms.block(USV_ACOMMS)],
+             "auv0": [acomms.block(AUV_ACOMMS)]}
     with contextlib.ExitStack() as exits:
-        brokers = {}
-        for name, links in (("topside", [sat_link(TOPSIDE_SAT)]), ("usv", [sat_link(USV_SAT), acomms_link(USV_ACOMMS)]),
-                            ("auv0", [acomms_link(AUV_ACOMMS)])):
-            cfg = workdir / f"gobyd_{name}.pb.cfg"
-            cfg.write_text(broker_config(links, warp=WARP))
-            brokers[name] = exits.enter_context(BrokerProcess(workdir, platform=f"trail_{name}", extra_args=[str(cfg)],
-                                                              log_path=workdir / f"gobyd_{name}.log",
-                                                              startup_timeout=90.0))
+        brokers = exits.enter_context(link_brokers(workdir, links, "trail", warp=WARP, startup_timeout=90.0))
         db = exits.enter_context(moosdb_process(workdir, community="AUV0", warp=WARP))
         built = Fleet(workdir, brokers, db.port, _exits=exits)
         built.app("topside_manager", "translators.apps.topside_manager", "topside",

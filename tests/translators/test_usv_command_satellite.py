@@ -6,22 +6,17 @@ from __future__ import annotations
 
 import sys
 
-import pytest
 from translator_procs import run_cli, start_child, wait_showing_logs
 
-from gateway.goby.intervehicle.testing import (
-    broker_config,
-    link_block,
-    loopback_multicast_works,
-    random_multicast,
-)
-from gateway.goby.portal.testing import BrokerProcess, PortalClient
+from gateway.goby.intervehicle.testing import LoopbackLink, link_brokers
+from gateway.goby.portal.testing import PortalClient
+from tests.markers import needs_loopback_multicast
 from translators.apps.usv_command import EXIT_ACKNOWLEDGED
 from translators.usv import groups as usv_groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 
-pytestmark = pytest.mark.skipif(not loopback_multicast_works(), reason="multicast on 127.0.0.1 is not available here")
+pytestmark = needs_loopback_multicast
 
 WARP = 20
 SAT = [(1, 5, 64), (2, 5, 64)]
@@ -29,35 +24,28 @@ SIM = f"app {{ simulation {{ time {{ use_sim_time: true warp_factor: {WARP} refe
 
 
 def test_usv_command_over_the_satellite_link(tmp_path):
-    group, port = random_multicast()
-    brokers = {}
-    for name, modem in (("topside", 1), ("usv", 2)):
-        cfg = tmp_path / f"{name}_broker.pb.cfg"
-        cfg.write_text(SIM + broker_config([link_block(modem, group, port, SAT)]))
-        brokers[name] = BrokerProcess(tmp_path, platform=f"cmd_{name}", extra_args=[str(cfg)],
-                                      log_path=tmp_path / f"{name}.log").start()
+    sat = LoopbackLink(SAT)
     manager = None
-    try:
-        manager_cfg = tmp_path / "manager.pb.cfg"
-        manager_cfg.write_text(SIM)
-        manager = start_child("usv_manager", [sys.executable, "-m", "translators.apps.usv_manager",
-                                             str(manager_cfg), "-v"], tmp_path, brokers["usv"].env())
-        with PortalClient(brokers["usv"].interprocess_config(), name="usv_probe") as usv:
-            commands = usv.collect(usv_groups.usv_command, USVCommand)
-            acks = usv.collect(usv_groups.usv_command_ack, USVCommandAck)
-            assert usv.wait_subscribed()
-            wait_showing_logs(lambda: "waiting for USV commands" in manager.output(), 30, "usv-manager to start", manager)
-            tool_cfg = tmp_path / "tool.pb.cfg"
-            tool_cfg.write_text(SIM + "intervehicle: true\n")
-            result = run_cli(["polygon", "--sides", "5", "--radius", "250", "--timeout", "20", str(tool_cfg)],
-                             brokers["topside"].env(), tmp_path)
-            assert result.returncode == EXIT_ACKNOWLEDGED, result.stdout + result.stderr + manager.output()
-            assert "acked over the satellite link by satellite modem 2: slot wait" in result.stdout
-            usv.poll_until(lambda: bool(commands), 10)
-    finally:
-        if manager is not None:
-            manager.stop()
-        for b in brokers.values():
-            b.stop()
+    with link_brokers(tmp_path, {"topside": [sat.block(1)], "usv": [sat.block(2)]}, "cmd", header=SIM) as brokers:
+        try:
+            manager_cfg = tmp_path / "manager.pb.cfg"
+            manager_cfg.write_text(SIM)
+            manager = start_child("usv_manager", [sys.executable, "-m", "translators.apps.usv_manager",
+                                                 str(manager_cfg), "-v"], tmp_path, brokers["usv"].env())
+            with PortalClient(brokers["usv"].interprocess_config(), name="usv_probe") as usv:
+                commands = usv.collect(usv_groups.usv_command, USVCommand)
+                acks = usv.collect(usv_groups.usv_command_ack, USVCommandAck)
+                assert usv.wait_subscribed()
+                wait_showing_logs(lambda: "waiting for USV commands" in manager.output(), 30, "usv-manager to start", manager)
+                tool_cfg = tmp_path / "tool.pb.cfg"
+                tool_cfg.write_text(SIM + "intervehicle: true\n")
+                result = run_cli(["polygon", "--sides", "5", "--radius", "250", "--timeout", "20", str(tool_cfg)],
+                                 brokers["topside"].env(), tmp_path)
+                assert result.returncode == EXIT_ACKNOWLEDGED, result.stdout + result.stderr + manager.output()
+                assert "acked over the satellite link by satellite modem 2: slot wait" in result.stdout
+                usv.poll_until(lambda: bool(commands), 10)
+        finally:
+            if manager is not None:
+                manager.stop()
     assert [(c.polygon_sides, c.polygon_radius) for c in commands] == [(5, 250)]  # checked, then republished once
     assert [a.stage for a in acks] == [USVCommandAck.RECEIVED_BY_MANAGER]

@@ -31,6 +31,21 @@ def random_multicast() -> tuple[str, int]:
     return f"239.142.{rng.randrange(10, 250)}.{rng.randrange(1, 250)}", rng.randrange(40000, 60000)
 
 
+def join_multicast(group: str, port: int, interface: str = "0.0.0.0", bind_address: str = "0.0.0.0") -> socket.socket:
+    """A UDP socket bound to ``bind_address:port`` that has joined ``group`` on ``interface``; closed again if
+    any step fails (the OSError propagates)."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind((bind_address, port))
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
+                        struct.pack("4s4s", socket.inet_aton(group), socket.inet_aton(interface)))
+    except OSError:
+        sock.close()
+        raise
+    return sock
+
+
 def multicast_config(cfg: DriverConfig) -> udp_pb.Config:
     """The driver's ``[goby.acomms.udp_multicast.protobuf.config]`` block (defaults if absent)."""
     return cfg.Extensions[udp_pb.config]
@@ -56,13 +71,13 @@ class UDPMulticastDriver(DatagramDriver):
             raise ModemDriverError(f"udp_multicast.multicast_address {group!r}: {exc}") from None
         loopback = ipaddress.ip_address(self._mc.listen_address).is_loopback
         interface = "127.0.0.1" if loopback else "0.0.0.0"
-        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
         try:
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
             # Bind the wildcard address: on Linux a socket bound to 127.0.0.1 does not receive multicast.
-            sock.bind(("0.0.0.0" if loopback else self._mc.listen_address, port))
-            sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
-                            struct.pack("4s4s", socket.inet_aton(group), socket.inet_aton(interface)))
+            sock = join_multicast(group, port, interface, "0.0.0.0" if loopback else self._mc.listen_address)
+        except OSError as exc:
+            raise ModemDriverError(f"udp_multicast: cannot listen on {group}:{port} "
+                                   f"(listen_address {self._mc.listen_address}): {exc}") from None
+        try:
             sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
             sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 1)
             if loopback:

@@ -17,7 +17,11 @@ from google.protobuf.message import Message
 
 from gateway.goby.dccl import DcclError
 from gateway.goby.intervehicle import groups
-from gateway.goby.intervehicle.errors import InvalidPublicationError, InvalidSubscriptionError
+from gateway.goby.intervehicle.errors import (
+    IntervehicleError,
+    InvalidPublicationError,
+    InvalidSubscriptionError,
+)
 from gateway.goby.intervehicle.options import Publisher, Subscriber
 from gateway.goby.intervehicle.protobuf.intervehicle_pb2 import (
     AckMessagePair,
@@ -39,6 +43,18 @@ log = logging.getLogger(__name__)
 LAYER = "intervehicle"
 #: Pending acks older than the largest ttl (DCCL bound 86400 s) plus 1 s are forgotten (as Goby purges them).
 PENDING_PURGE_US = 86_401_000_000
+
+
+def _numeric_group(group: GroupLike, error: type[IntervehicleError], has_group_function: bool,
+                   no_group_function: Callable[[Group], str]) -> Group:
+    """``group`` as a Group if intervehicle can carry it: it has a numeric id, and a group other than the broadcast
+    one comes with a group function (DCCL carries no group); else ``error`` naming what is missing."""
+    grp = as_group(group)
+    if grp.numeric is None:
+        raise error(f"intervehicle group {grp} needs a numeric id (e.g. \"{grp};1\")")
+    if grp.numeric != BROADCAST_GROUP and not has_group_function:
+        raise error(no_group_function(grp))
+    return grp
 
 
 @dataclass(eq=False)
@@ -78,13 +94,9 @@ class InterVehicleForwarder:
         here (DCCL and PROTOBUF, as Goby does). Raises ``InvalidPublicationError`` for a group without a numeric
         id, or a non-broadcast group without ``publisher.set_group``."""
         publisher = publisher if publisher is not None else Publisher()
-        grp = as_group(group)
-        if grp.numeric is None:
-            raise InvalidPublicationError(f"intervehicle group {grp} needs a numeric id (e.g. \"{grp};1\")")
-        if grp.numeric != BROADCAST_GROUP and publisher.set_group is None:
-            raise InvalidPublicationError(
-                f"publishing {msg.DESCRIPTOR.full_name} on intervehicle group {grp} (numeric {grp.numeric}) needs a "
-                "Publisher with set_group: DCCL messages do not carry a group")
+        grp = _numeric_group(group, InvalidPublicationError, publisher.set_group is not None, lambda grp: (
+            f"publishing {msg.DESCRIPTOR.full_name} on intervehicle group {grp} (numeric {grp.numeric}) needs a "
+            "Publisher with set_group: DCCL messages do not carry a group"))
         copy = type(msg)()
         copy.CopyFrom(msg)
         if publisher.set_group is not None:
@@ -115,13 +127,9 @@ class InterVehicleForwarder:
         (``subscriber.group(msg)``, else the broadcast group) equals ``group``; the Subscription is sent to
         ``cfg.intervehicle.publisher_id``. A second subscribe to the same (type, group) replaces the first."""
         subscriber = subscriber if subscriber is not None else Subscriber()
-        grp = as_group(group)
-        if grp.numeric is None:
-            raise InvalidSubscriptionError(f"intervehicle group {grp} needs a numeric id (e.g. \"{grp};1\")")
-        if grp.numeric != BROADCAST_GROUP and subscriber.group is None:
-            raise InvalidSubscriptionError(
-                f"subscribing to {msg_type.DESCRIPTOR.full_name} on intervehicle group {grp} needs a Subscriber with "
-                "a group function: DCCL messages do not carry a group")
+        grp = _numeric_group(group, InvalidSubscriptionError, subscriber.group is not None, lambda grp: (
+            f"subscribing to {msg_type.DESCRIPTOR.full_name} on intervehicle group {grp} needs a Subscriber with "
+            "a group function: DCCL messages do not carry a group"))
         cfg = subscriber.transporter_config()
         if cfg.intervehicle.broadcast and cfg.intervehicle.buffer.ack_required:
             raise InvalidSubscriptionError(f"subscription to {grp}: broadcast with ack_required is not allowed")

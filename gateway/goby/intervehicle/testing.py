@@ -1,30 +1,31 @@
-"""Test helpers for the intervehicle layer: link config blocks, a multicast availability check, and a portal client
-with an intervehicle forwarder driven by the test's own thread."""
+"""Test helpers for the intervehicle layer: link config blocks, goby-broker processes hosting links, a multicast
+availability check, and a portal client with an intervehicle forwarder driven by the test's own thread."""
 
 from __future__ import annotations
 
+import contextlib
 import socket
-import struct
-from collections.abc import Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
 
-__all__ = ["IntervehicleClient", "broker_config", "link_block", "loopback_multicast_works", "random_multicast"]
+__all__ = ["IntervehicleClient", "LoopbackLink", "broker_config", "link_block", "link_brokers",
+           "loopback_multicast_works", "random_multicast"]
 
-from gateway.goby.acomms.udp_multicast import random_multicast
+from gateway.goby.acomms.udp_multicast import join_multicast, random_multicast
 from gateway.goby.intervehicle.forwarder import InterVehicleForwarder
-from gateway.goby.portal.testing import PortalClient
+from gateway.goby.portal.testing import BrokerProcess, PortalClient
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 
 
 def loopback_multicast_works(timeout_s: float = 1.0) -> bool:
     """True when a datagram sent to a multicast group on 127.0.0.1 comes back (the UDP multicast driver needs it)."""
     group, port = random_multicast()
-    rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+    try:
+        rx = join_multicast(group, port, interface="127.0.0.1")
+    except OSError:
+        return False
     tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
     try:
-        rx.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        rx.bind(("0.0.0.0", port))
-        rx.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
-                      struct.pack("4s4s", socket.inet_aton(group), socket.inet_aton("127.0.0.1")))
         tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton("127.0.0.1"))
         tx.sendto(b"probe", (group, port))
         rx.settimeout(timeout_s)
@@ -47,10 +48,42 @@ def link_block(modem_id: int, group: str, port: int, slots: Sequence[tuple[int, 
             f"mac {{ type: MAC_FIXED_DECENTRALIZED {slot_text} }} }}")
 
 
+class LoopbackLink:
+    """A simulated link: UDP multicast on loopback on a group and port of its own, TDMA with ``(src, s, bytes)``."""
+
+    def __init__(self, slots: Sequence[tuple[int, float, int]]) -> None:
+        self.group, self.port = random_multicast()
+        self.slots = list(slots)
+
+    def block(self, modem_id: int, subnet_mask: int = 0xFF00) -> str:
+        """The ``link {}`` block of the modem ``modem_id`` on this link."""
+        return link_block(modem_id, self.group, self.port, self.slots, subnet_mask)
+
+
 def broker_config(links: Sequence[str], warp: int = 1) -> str:
     """A goby-broker config file's text with these links, warped."""
     sim = f"app {{ simulation {{ time {{ use_sim_time: true warp_factor: {warp} }} }} }}\n" if warp > 1 else ""
     return sim + "intervehicle {\n  " + "\n  ".join(links) + "\n}\n"
+
+
+@contextlib.contextmanager
+def link_brokers(workdir: Path, links: Mapping[str, Sequence[str]], prefix: str, warp: int = 1, header: str = "",
+                 startup_timeout: float = 30.0) -> Iterator[dict[str, BrokerProcess]]:
+    """One goby-broker process per name (platform ``<prefix>_<name>``), each hosting its ``link {}`` blocks, with
+    ``header`` (an ``app {}`` block) and ``broker_config(links, warp)`` as its config file
+    (``workdir/gobyd_<name>.pb.cfg``, log ``workdir/gobyd_<name>.log``); all are stopped on leaving."""
+    brokers: dict[str, BrokerProcess] = {}
+    try:
+        for name, blocks in links.items():
+            cfg = workdir / f"gobyd_{name}.pb.cfg"
+            cfg.write_text(header + broker_config(blocks, warp=warp))
+            brokers[name] = BrokerProcess(workdir, platform=f"{prefix}_{name}", extra_args=[str(cfg)],
+                                          log_path=workdir / f"gobyd_{name}.log", startup_timeout=startup_timeout)
+            brokers[name].start()
+        yield brokers
+    finally:
+        for broker in brokers.values():
+            broker.stop()
 
 
 class IntervehicleClient(PortalClient):

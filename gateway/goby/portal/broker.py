@@ -138,14 +138,8 @@ class Broker:
             xsub.close()
             self.stop()
             raise BrokerError(f"cannot bind the broker's pub/sub sockets: {exc}") from exc
-        control_addr = f"inproc://broker-control-{id(self)}"
-        control_peer = self._zctx.socket(zmq.PAIR)
-        control_peer.bind(control_addr)
-        self._proxy_control = self._zctx.socket(zmq.PAIR)
-        self._proxy_control.connect(control_addr)
-        proxy = threading.Thread(target=self._run_proxy, args=(xpub, xsub, control_peer), name="broker-proxy")
-        proxy.start()
-        self._threads.append(proxy)
+        self._proxy_control = self._start_thread(self._zctx, "broker-control", self._run_proxy, (xpub, xsub),
+                                                 "broker-proxy")
 
         rep = self._mctx.socket(zmq.REP)
         rep.setsockopt(zmq.LINGER, 0)
@@ -164,14 +158,8 @@ class Broker:
             rep.close()
             self.stop()
             raise BrokerError(f"cannot bind the manager socket {manager_endpoint(self.ipc)}: {exc}") from exc
-        stop_addr = f"inproc://broker-manager-stop-{id(self)}"
-        stop_peer = self._mctx.socket(zmq.PAIR)
-        stop_peer.bind(stop_addr)
-        self._manager_stop = self._mctx.socket(zmq.PAIR)
-        self._manager_stop.connect(stop_addr)
-        manager = threading.Thread(target=self._run_manager, args=(rep, stop_peer), name="broker-manager")
-        manager.start()
-        self._threads.append(manager)
+        self._manager_stop = self._start_thread(self._mctx, "broker-manager-stop", self._run_manager, (rep,),
+                                                "broker-manager")
         if not self._ready.wait(10):
             self.stop()
             raise BrokerError("the broker's manager thread did not become ready within 10 s")
@@ -179,6 +167,20 @@ class Broker:
         if self.cfg.HasField("intervehicle"):
             self._start_intervehicle()
         return self
+
+    def _start_thread(self, zctx: zmq.Context, channel: str, target: Any, args: tuple[Any, ...],
+                      name: str) -> zmq.Socket:
+        """Start ``target(*args, peer)`` on a thread of its own, ``peer`` one end of an inproc PAIR channel; returns
+        the other end, through which this object tells the thread to stop."""
+        addr = f"inproc://{channel}-{id(self)}"
+        peer = zctx.socket(zmq.PAIR)
+        peer.bind(addr)
+        control = zctx.socket(zmq.PAIR)
+        control.connect(addr)
+        thread = threading.Thread(target=target, args=(*args, peer), name=name)
+        thread.start()
+        self._threads.append(thread)
+        return control
 
     def _start_intervehicle(self) -> None:
         """Run the intervehicle links in this process, as gobyd does (raises ``BrokerError`` naming the link)."""

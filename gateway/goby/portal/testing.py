@@ -283,6 +283,18 @@ class PortalClient:
         self.close()
 
 
+
+def poll_all(clients: list[PortalClient], predicate: Callable[[], object], timeout_s: float) -> bool:
+    """Poll every client in turn (their callbacks run here) until ``predicate()`` is true; False after
+    ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        for c in clients:
+            c.poll(0.01)
+        if predicate():
+            return True
+    return False
+
 def app_process(args: list[str], log_path: str | os.PathLike[str], *, env: dict[str, str] | None = None,
                 cwd: str | os.PathLike[str] | None = None) -> ChildProcess:
     """An application started as a child process: its stdout (what tests wait for: ``wait_for_output``, ``lines()``)
