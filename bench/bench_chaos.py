@@ -1,10 +1,14 @@
-"""Chaos soak of the USV mission: random SIGKILLs, restarts, recovery times, accounting, memory.
+"""Chaos soak of the USV or the trail mission: random SIGKILLs, restarts, recovery times, accounting, memory.
 
-    python -m bench.bench_chaos [--duration 1800] [--warp 20] [--interval 20] [--seed 1] [--out DIR] [--quick]
+    python -m bench.bench_chaos [--mission usv|trail] [--auvs 2] [--duration 1800] [--warp 20] [--interval 20]
+                                [--seed 1] [--out DIR] [--quick]
 
-Runs ``launch/usv/usv.launch`` (every process, generated configs, the shore's command schedule) at high warp. Every
-``--interval`` seconds on average (exponential) it picks a random process, kills it with SIGKILL and restarts it
-(``ProcessGroup.respawn``, what a supervising launcher does). Two probes count messages end to end meanwhile:
+``--mission usv`` (default) runs ``launch/usv/usv.launch`` (every process, generated configs, the shore's command
+schedule) at high warp. Every ``--interval`` seconds on average (exponential) it picks a random process, kills it
+with SIGKILL and restarts it (``ProcessGroup.respawn``, what a supervising launcher does). ``--mission trail`` runs
+the trail mission as all.launch does (topside, USV, ``--auvs`` AUVs, nested goby-launch per platform, started with
+``GOBY_LAUNCH_RESPAWN``) and kills a random process of a random platform: its own launcher starts it again. Two
+probes count messages end to end on the USV meanwhile:
 
 - MOOS: a publisher posts ``CHAOS_SEQ`` 0, 1, 2, ... every 50 ms to moos-db, a subscriber reads them; each number
   is delivered, refused (``notify`` False) or reported undelivered (the on-undelivered callback);
@@ -12,7 +16,8 @@ Runs ``launch/usv/usv.launch`` (every process, generated configs, the shore's co
   (``publish`` False while the portal knows the broker is gone) or reported (``portal.unsent``);
 
 anything else is *lost silently*. A kill counts as recovered when the restarted process has stayed up 1 s, the
-vehicle's NAV_X reaches the MOOSDB again and both probes deliver again; the recovery time is from the kill.
+vehicle's NAV_X reaches the MOOSDB again (every vehicle's, in the trail mission) and both probes deliver again; the
+recovery time is from the kill.
 Prints one row per process: kills, recovery median/max, the probes' messages sent while it was down and how they
 ended, and RSS at start and end (the latest instance). Exit 0 when nothing was lost silently and every kill
 recovered.
@@ -23,7 +28,9 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import os
 import random
+import re
 import signal
 import statistics
 import sys
@@ -38,9 +45,12 @@ from gateway.goby.portal.testing import PortalClient
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from gateway.moos import comms
 from gateway.moos.clock import MoosClock
-from launch.process_group import ManagedProcess
+from launch.apps.goby_launch import RESPAWN_VAR
+from launch.trail.mission import TrailMission, with_free_ports
+from launch.trail.settings import TrailSettings, Vehicle
 from launch.usv.mission import UsvMission
 from launch.usv.settings import UsvSettings
+from util.cli import bounded_number
 from util.logsetup import add_verbosity_argument, configure_logging
 from util.process import free_port, handle_signals
 
@@ -212,19 +222,127 @@ class Kill:
     recovered_at: float | None = None
 
 
-def _wait_recovered(mission: UsvMission, probes: tuple[MoosProbe, PortalProbe], process: ManagedProcess,
-                    kill: Kill) -> None:
+class UsvTarget:
+    """The USV mission as one flat process group: the soak kills a process and restarts it itself."""
+
+    def __init__(self, args: argparse.Namespace, out: Path, socket_dir: Path) -> None:
+        self.settings = UsvSettings(run_dir=out, warp=args.warp, moos_port=free_port(), sim_port=free_port(),
+                                    liaison_port=free_port(), socket_name=str(socket_dir / "goby_usv"))
+        self.mission = UsvMission(self.settings, report=log.info)
+        self.log_dir = self.settings.log_dir
+        self.probe_moos_port, self.probe_platform = self.settings.moos_port, self.settings.platform
+        self.probe_ipc_base = self.settings.ipc_base
+
+    def start(self) -> None:
+        self.mission.start()
+        self.mission.wait_for_command(180)
+
+    def stop(self) -> None:
+        self.mission.stop()
+
+    def poll(self) -> None:
+        self.mission.moos.poll()  # type: ignore[union-attr]
+
+    def _group(self):  # noqa: ANN202
+        assert self.mission.group is not None
+        return self.mission.group
+
+    def processes(self) -> dict[str, int]:
+        return {p.name: p.pid for p in self._group().processes if p.running}
+
+    def kill(self, name: str) -> None:
+        process = next(p for p in self._group().processes if p.name == name)
+        process.child.send_signal(signal.SIGKILL)
+        process.child.wait(10)
+        self._group().respawn(process)
+
+    def nav_since(self, kill: Kill, last_nav: float) -> bool:
+        return last_nav > kill.at
+
+    def back(self, name: str, kill: Kill) -> bool:
+        process = next(p for p in self._group().processes if p.name == name)
+        if not process.running:  # died again on its own (e.g. its peer was not back yet): restart it
+            self._group().respawn(process)
+            return False
+        return time.monotonic() - process.started_at >= 1.0
+
+
+_LAUNCHED = re.compile(r"^Launched \((\d+)\) (\S+):", re.M)
+
+
+class TrailTarget:
+    """The trail mission as all.launch runs it; every platform's goby-launch restarts what the soak kills."""
+
+    def __init__(self, args: argparse.Namespace, out: Path, socket_dir: Path) -> None:
+        base = TrailSettings(run_dir=out, warp=args.warp, socket_dir=socket_dir, schedule="none")
+        self.settings = with_free_ports(base, args.auvs, prefer_course=False)
+        self.mission = TrailMission(self.settings, args.auvs, report=log.info, extra_env={RESPAWN_VAR: "1000000"})
+        self.log_dir = self.mission.log_dir
+        usv = Vehicle("usv", args.auvs)
+        self.probe_moos_port, self.probe_platform = usv.moos_port(self.settings), usv.name
+        self.probe_ipc_base = usv.ipc_base(self.settings)
+        self._killed: tuple[str, int, float] = ("", 0, 0.0)  # name, pid, sim time of the last kill
+        self._seen: dict[int, float] = {}  # when each new pid was first seen
+
+    def start(self) -> None:
+        self.mission.start()
+        self.mission.wait_for_command(300)
+
+    def stop(self) -> None:
+        self.mission.stop()
+
+    def poll(self) -> None:
+        self.mission.poll()
+
+    def processes(self) -> dict[str, int]:
+        """The live programs under every platform's launcher, by name (``auv0.moos-db``), from its log."""
+        assert self.mission.group is not None
+        found: dict[str, int] = {}
+        for launcher in self.mission.group.processes:
+            for pid, name in _LAUNCHED.findall(launcher.child.output()):
+                found[name] = int(pid)  # the newest launch of each name wins
+        return {name: pid for name, pid in found.items() if _alive(pid)}
+
+    def kill(self, name: str) -> None:
+        self._killed = (name, self.processes()[name], self.mission.clock.now())
+        self._seen.clear()
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(self._killed[1], signal.SIGKILL)
+
+    def nav_since(self, kill: Kill, last_nav: float) -> bool:
+        """Every vehicle with a MOOSDB has had a NAV fix since the kill (the USV's is also the probe's)."""
+        for run in self.mission.runs.values():
+            nav, _ = run.record.snapshot()
+            if run.moos is not None and (not nav or nav[-1].t <= self._killed[2]):
+                return False
+        return last_nav > kill.at
+
+    def back(self, name: str, kill: Kill) -> bool:
+        """Its launcher has started it again (a new pid under the same name) and it has been up 1 s."""
+        pid = self.processes().get(name)
+        if pid is None or pid == self._killed[1]:
+            return False
+        first_seen = self._seen.setdefault(pid, time.monotonic())
+        return time.monotonic() - first_seen >= 1.0
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def _wait_recovered(target: UsvTarget | TrailTarget, probes: tuple[MoosProbe, PortalProbe], kill: Kill) -> None:
     moos, portal = probes
     deadline = kill.at + RECOVERY_TIMEOUT_S
     while time.monotonic() < deadline:
-        mission.moos.poll()  # type: ignore[union-attr]
-        up = process.running and time.monotonic() - process.started_at >= 1.0
-        fresh = min(moos.last_nav, moos.ledger.last_delivery, portal.ledger.last_delivery) > kill.at
-        if up and fresh:
+        target.poll()
+        fresh = target.nav_since(kill, moos.last_nav) and min(moos.ledger.last_delivery,
+                                                                portal.ledger.last_delivery) > kill.at
+        if target.back(kill.name, kill) and fresh:
             kill.recovered_at = time.monotonic()
             return
-        if not process.running:  # died again on its own (e.g. its peer was not back yet): restart it
-            process = mission.group.respawn(process)  # type: ignore[union-attr]
         time.sleep(0.05)
 
 
@@ -232,47 +350,41 @@ def run(args: argparse.Namespace) -> int:
     rng = random.Random(args.seed)
     out = Path(args.out or tempfile.mkdtemp(prefix="chaos_"))
     socket_dir = Path(tempfile.mkdtemp(prefix="cs", dir="/tmp"))
-    settings = UsvSettings(run_dir=out, warp=args.warp, moos_port=free_port(), sim_port=free_port(),
-                           liaison_port=free_port(), socket_name=str(socket_dir / "goby_usv"))
-    mission = UsvMission(settings, report=log.info)
+    target = (TrailTarget if args.mission == "trail" else UsvTarget)(args, out, socket_dir)
     kills: list[Kill] = []
     signals = contextlib.ExitStack()  # SIGINT/SIGTERM end the soak early; the previous handlers come back at the end
     stop = signals.enter_context(handle_signals())
     try:
-        mission.start()
-        mission.wait_for_command(180)
-        group = mission.group
-        assert group is not None and mission.moos is not None
-        rss_start = {p.name: rss_mib(p.pid) for p in group.processes}
-        probes = (MoosProbe(settings.moos_port, settings.warp), PortalProbe(settings.platform, settings.ipc_base))
+        target.start()
+        rss_start = {name: rss_mib(pid) for name, pid in target.processes().items()}
+        probes = (MoosProbe(target.probe_moos_port, args.warp), PortalProbe(target.probe_platform,
+                                                                            target.probe_ipc_base))
         for probe in probes:
             probe.start()
-        print(f"chaos soak: {args.duration:g} s, warp {args.warp}, a kill every ~{args.interval:g} s; "
-              f"logs in {settings.log_dir}", flush=True)
+        print(f"chaos soak of the {args.mission} mission: {args.duration:g} s, warp {args.warp}, a kill every "
+              f"~{args.interval:g} s; logs in {target.log_dir}", flush=True)
         end = time.monotonic() + args.duration
         while time.monotonic() < end and not stop.is_set():
             pause = min(rng.expovariate(1.0 / args.interval), max(0.0, end - time.monotonic()))
             wake = time.monotonic() + pause
             while time.monotonic() < wake and not stop.is_set():
-                mission.moos.poll()
+                target.poll()
                 time.sleep(0.05)
             if time.monotonic() >= end or stop.is_set():
                 break
-            victim = rng.choice([p for p in group.processes if p.running
-                                 and (not args.victims or any(v in p.name for v in args.victims.split(",")))])
-            kill = Kill(victim.name, time.monotonic())
+            names = sorted(n for n in target.processes()
+                           if not args.victims or any(v in n for v in args.victims.split(",")))
+            kill = Kill(rng.choice(names), time.monotonic())
             kills.append(kill)
-            victim.child.send_signal(signal.SIGKILL)
-            victim.child.wait(10)
-            process = group.respawn(victim)
-            _wait_recovered(mission, probes, process, kill)
+            target.kill(kill.name)
+            _wait_recovered(target, probes, kill)
             took = f"{kill.recovered_at - kill.at:.1f} s" if kill.recovered_at else "NOT recovered"
             print(f"{time.strftime('%H:%M:%S')} kill -9 {kill.name}: recovered in {took}", flush=True)
-        rss_end = {p.name: rss_mib(p.pid) for p in group.processes}
+        rss_end = {name: rss_mib(pid) for name, pid in target.processes().items()}
         for probe in probes:
             probe.stop()
     finally:
-        mission.stop()
+        target.stop()
         signals.close()
     print(report(kills, probes, rss_start, rss_end, args))
     lost = sum(len(p.ledger.lost()) for p in probes)
@@ -317,13 +429,16 @@ def report(kills: list[Kill], probes: tuple[MoosProbe, PortalProbe], rss_start: 
                       f"lost silently {len(ledger.lost())}")
     header = ["process", "kills", "recovery median s", "recovery max s", "MOOS probe sent/delivered/reported/lost",
               "interprocess probe sent/delivered/reported/lost", "RSS MiB start → end"]
-    return "\n".join([f"Chaos soak: {args.duration:g} s real time at warp {args.warp}, {len(kills)} kills "
+    return "\n".join([f"Chaos soak of the {args.mission} mission: {args.duration:g} s real time at warp {args.warp}, "
+                      f"{len(kills)} kills "
                       f"(seed {args.seed}); probe counts are messages sent while that process was down",
                       markdown_table(header, rows), *totals])
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench.bench_chaos", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--mission", choices=("usv", "trail"), default="usv", help="which mission (default usv)")
+    parser.add_argument("--auvs", type=bounded_number(int, 0, 16), default=2, help="AUVs of the trail mission (2)")
     parser.add_argument("--duration", type=float, default=1800.0, help="real seconds of chaos (default 1800)")
     parser.add_argument("--warp", type=int, default=20, help="time warp of the mission (default 20)")
     parser.add_argument("--interval", type=float, default=20.0, help="mean real seconds between kills (default 20)")

@@ -43,6 +43,7 @@ class ManagedProcess:
     child: ChildProcess
     started_at: float = field(default_factory=time.monotonic)
     reported: bool = False
+    respawns: int = 0  # how often a supervisor started it again after it died
 
     @property
     def pid(self) -> int:
@@ -206,8 +207,8 @@ class ProcessGroup:
     def respawn(self, process: ManagedProcess) -> ManagedProcess:
         """Start a process that ended again, same entry and name (its log is appended to); returns it.
 
-        For supervisors that restart what dies (the chaos soak, bench/bench_chaos.py); the launcher itself
-        stops everything when one process dies, as goby_launch does.
+        For supervisors that restart what dies (``supervise(respawn_limit=)``, the chaos soak in
+        bench/bench_chaos.py); by default the launcher stops everything when one process dies, as goby_launch does.
         """
         if process.running:
             raise LaunchError(f"{process.name} is still running; stop it before respawning it")
@@ -218,14 +219,17 @@ class ProcessGroup:
             raise LaunchError(f"cannot start {process.name!r} ({process.entry.command}): {exc}") from exc
         process.reported = False
         process.started_at = time.monotonic()
+        process.respawns += 1
         self.report(f"Launched ({process.pid}) {process.name}: {process.entry.command}")
         return process
 
-    def supervise(self, status_period_s: float = 5.0) -> int:
+    def supervise(self, status_period_s: float = 5.0, respawn_limit: int = 0) -> int:
         """Watch the processes until stop_event is set, one dies, or all finish; then stop them all.
 
+        A process that dies is started again (its log appended to) while it has died no more than
+        ``respawn_limit`` times; past that, or with the default 0, the others are stopped as goby_launch does.
         Returns the exit status for the launcher: 0 after a requested stop or when every process
-        finished cleanly, 1 when a process died (named in the report with the tail of its log).
+        finished cleanly, 1 when a process died for good (named in the report with the tail of its log).
         """
         next_status = time.monotonic()
         status = 0
@@ -233,11 +237,14 @@ class ProcessGroup:
             while not self.stop_event.is_set():
                 died = self.check()
                 if died is not None:
-                    self.report(
-                        f"[{self.platform}] {time.strftime('%H:%M:%S')}: {died.name} died unexpectedly "
-                        f"(exit status {died.returncode}); stopping the others. Last lines of "
-                        f"{died.log_path}:\n{died.log_tail()}"
-                    )
+                    stamp = f"[{self.platform}] {time.strftime('%H:%M:%S')}: {died.name} died unexpectedly " \
+                            f"(exit status {died.returncode})"
+                    tail = f"Last lines of {died.log_path}:\n{died.log_tail()}"
+                    if died.respawns < respawn_limit:
+                        self.report(f"{stamp}; respawning it ({died.respawns + 1} of {respawn_limit}). {tail}")
+                        self.respawn(died)
+                        continue
+                    self.report(f"{stamp}; stopping the others. {tail}")
                     status = 1
                     break
                 if not self.running():

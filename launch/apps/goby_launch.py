@@ -3,7 +3,8 @@
 Processes start in order with a delay (``-d`` ms), each with its own log file (``-L`` directory);
 the launcher reports every few seconds which are up. Ctrl-C or SIGTERM stops them in reverse order
 (the line's kill signal, then SIGKILL after ``-k`` seconds). If one dies, the launcher names it, shows
-the tail of its log, stops the rest and exits non-zero.
+the tail of its log, stops the rest and exits non-zero; with ``--respawn N`` (or ``GOBY_LAUNCH_RESPAWN=N``,
+which nested launchers inherit) it starts a dead process again, up to N times each, before giving up.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from pathlib import Path
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import parse_file
 from launch.process_group import ProcessGroup, child_environment
+from util.cli import bounded_number
 from util.logsetup import add_verbosity_argument, configure_logging
 from util.process import handle_signals
 
@@ -31,6 +33,7 @@ PRESEED = "preseed.goby"  # sourced before each command when it sits next to the
 LAUNCH_DIR_VAR = "GOBY_LAUNCH_DIR"
 LOG_DIR_VAR = "GOBY_LAUNCH_LOG_DIR"
 PLATFORM_VAR = "GOBY_LAUNCH_PLATFORM"  # the platform name (-p), for name= directives
+RESPAWN_VAR = "GOBY_LAUNCH_RESPAWN"  # default of --respawn; inherited by nested launchers (not in goby_launch)
 _UNSUPPORTED_MODES = {
     "screen": "-s (GNU screen)",
     "nohup": "-n (nohup)",
@@ -58,6 +61,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-b", dest="background", action="store_true", help="not supported here")
     parser.add_argument("--status-period", type=float, default=5.0, help="seconds between status lines (5)")
     parser.add_argument("--startup-check", type=float, default=1.0, help="seconds to watch after the last launch (1)")
+    parser.add_argument("--respawn", type=bounded_number(int, 0), default=None, metavar="N",
+                        help=f"start a process that dies again, up to N times each (default ${RESPAWN_VAR} or 0: "
+                        "the first death stops everything, as goby_launch does)")
     add_verbosity_argument(parser)
     return parser
 
@@ -82,6 +88,11 @@ def main(argv: list[str] | None = None) -> int:
     except LaunchError as exc:
         print(f"goby-launch: {exc}", file=sys.stderr)
         return 1
+    try:
+        respawn_limit = args.respawn if args.respawn is not None else int(os.environ.get(RESPAWN_VAR, "0"))
+    except ValueError:
+        print(f"goby-launch: {RESPAWN_VAR}={os.environ[RESPAWN_VAR]!r} is not a whole number", file=sys.stderr)
+        return 2
     platform = args.platform or Path(args.launchfile).stem
     log_dir = default_log_dir(platform, os.environ) if args.log_dir is None else args.log_dir
     env = child_environment()
@@ -119,7 +130,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"goby-launch: {exc}", file=sys.stderr, flush=True)
             return 1
         print("Use <CTRL+C> to exit", flush=True)
-        return group.supervise(status_period_s=args.status_period)
+        return group.supervise(status_period_s=args.status_period, respawn_limit=respawn_limit)
 
 
 if __name__ == "__main__":

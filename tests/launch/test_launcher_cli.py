@@ -200,3 +200,55 @@ def test_respawn_starts_an_ended_process_again_and_appends_to_its_log(tmp_path):
         wait_until(lambda: not again.running, 20, "the second run to end")
         assert again.returncode == 3
     assert (tmp_path / "logs" / "once.log").read_text().count("run ") == 2
+
+
+def test_respawn_flag_restarts_a_killed_process_up_to_its_limit(tmp_path, child_script):
+    launch_file = tmp_path / "two.launch"
+    launch_file.write_text(f"[name=steady] {sys.executable} {child_script} steady\n"
+                           f"[name=victim] {sys.executable} {child_script} victim\n")
+    logs = tmp_path / "logs"
+    run = start_launcher(launch_file, logs, "--respawn", "1")
+    try:
+        wait_until(lambda: "Use <CTRL+C>" in run.output(), 30, "start-up done")  # a death before is a failure
+        steady, victim = _launched_pids(run.output())
+        os.kill(victim, signal.SIGKILL)
+        wait_until(lambda: len(_launched_pids(run.output())) == 3, 30, "the victim launched again")
+        again = _launched_pids(run.output())[2]
+        wait_until(lambda: _read(logs / "victim.log").count("victim up") == 2, 30, "the second victim up")
+        assert "respawning it (1 of 1)" in run.output()
+        assert _pid_alive(steady) and run.running
+        os.kill(again, signal.SIGKILL)  # the second death is past the limit: everything stops, exit 1
+        output = finish(run)
+    finally:
+        run.stop()
+    assert run.returncode == 1, output
+    assert "victim died unexpectedly (exit status -9); stopping the others" in output
+    assert not _pid_alive(steady)
+
+
+def test_respawn_comes_from_the_environment_for_nested_launchers(tmp_path, child_script):
+    launch_file = tmp_path / "one.launch"
+    launch_file.write_text(f"[name=victim] {sys.executable} {child_script} victim\n")
+    logs = tmp_path / "logs"
+    run = ChildProcess([sys.executable, "-m", "launch.apps.goby_launch", "-d", "50", "-L", str(logs), str(launch_file)],
+                       tmp_path / "goby-launch.out", env=os.environ | {"GOBY_LAUNCH_RESPAWN": "2"}).start()
+    try:
+        wait_until(lambda: "Use <CTRL+C>" in run.output(), 30, "start-up done")
+        os.kill(_launched_pids(run.output())[0], signal.SIGKILL)
+        wait_until(lambda: "respawning it (1 of 2)" in run.output(), 30, "the respawn")
+    finally:
+        run.send_signal(signal.SIGINT)
+        output = finish(run)
+    assert run.returncode == 0, output
+
+
+def test_respawn_refuses_a_bad_count(tmp_path):
+    launch_file = tmp_path / "one.launch"
+    launch_file.write_text("sleep 1\n")
+    result = subprocess.run([sys.executable, "-m", "launch.apps.goby_launch", "--respawn", "-1", str(launch_file)],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2 and "--respawn" in result.stderr
+
+
+def _read(path: Path) -> str:
+    return path.read_text() if path.exists() else ""
