@@ -17,6 +17,9 @@ log = logging.getLogger(__name__)
 # pNodeReporter's guesses for an unknown platform_length, by platform_type.
 _DEFAULT_LENGTHS = {"kayak": 4.0, "mokai": 4.0, "auv": 4.0, "uuv": 4.0, "ship": 8.0, "glider": 3.0, "usv": 6.0,
                     "kingfisher": 3.0}
+#: The NAV_* variables copied as they are into the report (NAV_HEADING is normalised to [0, 360)).
+_NAV_FIELDS = {"NAV_X": "x", "NAV_Y": "y", "NAV_LAT": "lat", "NAV_LONG": "lon", "NAV_SPEED": "speed",
+               "NAV_DEPTH": "depth", "NAV_YAW": "yaw"}
 _HELM_STATES = ("DRIVE", "PARK", "MALCONFIG", "DISABLED")
 _MOOS_APP_PARAMS = {"apptick", "commstick", "maxapptick", "app_logging", "term_report_interval",
                     "max_appcast_events"}
@@ -113,22 +116,10 @@ class NodeReporter:
         """One message; numbers for NAV_*, strings for the helm's variables and PNR_PAUSE."""
         record = self.record
         if isinstance(value, float):
-            if var == "NAV_X":
-                record.x = value
-            elif var == "NAV_Y":
-                record.y = value
-            elif var == "NAV_LAT":
-                record.lat = value
-            elif var == "NAV_LONG":
-                record.lon = value
-            elif var == "NAV_SPEED":
-                record.speed = value
-            elif var == "NAV_HEADING":
+            if var == "NAV_HEADING":
                 record.heading = angle360(value)
-            elif var == "NAV_DEPTH":
-                record.depth = value
-            elif var == "NAV_YAW":
-                record.yaw = value
+            elif var in _NAV_FIELDS:
+                setattr(record, _NAV_FIELDS[var], value)
             return
         if var == "IVPHELM_SUMMARY":
             self._helm_last = now

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, ClassVar, TypeVar
 
 from launch.errors import MissionConfigError
+from launch.textfile import read_text
 
 T = TypeVar("T")
 S = TypeVar("S", bound="EnvSettings")
@@ -28,10 +29,7 @@ SHARED_TEMPLATES = Path(__file__).resolve().parent / "templates"
 def render(template: str | Path, values: Mapping[str, object]) -> str:
     """Substitute ``$name`` placeholders in a template file; every placeholder must have a value."""
     path = Path(template)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise MissionConfigError(f"cannot read template {path}: {exc.strerror or exc}") from exc
+    text = read_text(path, MissionConfigError, "cannot read template {path}: {reason}")
     try:
         return string.Template(text).substitute({k: str(v) for k, v in values.items()})
     except KeyError as exc:

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from launch.errors import LaunchFileError
+from launch.textfile import read_text
 
 KILL_SIGNALS = {
     "SIGTERM": signal.SIGTERM,
@@ -149,10 +150,7 @@ def parse_lines(lines: Iterable[str], source: str = "<string>") -> LaunchFile:
 def parse_file(path: str | Path) -> LaunchFile:
     """Read and parse a launch file; a missing or unreadable file is a LaunchFileError."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise LaunchFileError(f"cannot read launch file {path}: {exc.strerror or exc}") from exc
+    text = read_text(path, LaunchFileError, "cannot read launch file {path}: {reason}")
     parsed = parse_lines(text.splitlines(), source=str(path))
     parsed.path = path
     if not parsed.entries:

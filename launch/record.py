@@ -12,6 +12,9 @@ import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
+#: Where ``MissionRecord.add_nav`` keeps each NAV_* variable's latest value.
+_NAV_ATTRIBUTES = {"NAV_X": "_x", "NAV_Y": "_y", "NAV_HEADING": "_heading", "NAV_SPEED": "_speed", "NAV_DEPTH": "_depth"}
+
 
 @dataclass(frozen=True)
 class NavSample:
@@ -51,19 +54,11 @@ class MissionRecord:
 
     def add_nav(self, t: float, name: str, value: float) -> None:
         """Fold one NAV_* value in; a position row is added (or its newest row updated) per update."""
+        attribute = _NAV_ATTRIBUTES.get(name)
+        if attribute is None:
+            return
         with self._lock:
-            if name == "NAV_X":
-                self._x = value
-            elif name == "NAV_Y":
-                self._y = value
-            elif name == "NAV_HEADING":
-                self._heading = value
-            elif name == "NAV_SPEED":
-                self._speed = value
-            elif name == "NAV_DEPTH":
-                self._depth = value
-            else:
-                return
+            setattr(self, attribute, value)
             if self._x is None or self._y is None:
                 return
             sample = NavSample(t, self._x, self._y, self._heading, self._speed, self._depth)

@@ -9,7 +9,6 @@ with one clock (sim seconds since the recorder started), so the two sides line u
 from __future__ import annotations
 
 import logging
-import threading
 import time
 from collections import Counter
 from typing import Any
@@ -19,6 +18,7 @@ from frontseat.protobuf.frontseat_pb2 import InterfaceState, InterfaceStatus
 from gateway.goby.portal import SimpleThread
 from gateway.moos import MoosClock, comms
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
+from launch.portal_thread import BackgroundPortalThread
 from launch.record import MissionRecord
 
 log = logging.getLogger(__name__)
@@ -134,10 +134,11 @@ class _PortalListener(SimpleThread):
         self._record.add_event(self._clock.now(), "ack", stage, posts or ack.error, ack.responder)
 
 
-class PortalRecorder:
+class PortalRecorder(BackgroundPortalThread):
     """Runs the portal listener on its own thread (built there, as portal threads own their sockets)."""
 
     def __init__(self, record: MissionRecord, clock: SimClock, platform: str, ipc_base: str) -> None:
+        super().__init__(f"{platform}-demo-portal", log, "portal recorder stopped")
         self._cfg = GobyMOOSGatewayConfig()
         self._cfg.app.name = "usv-demo-recorder"
         self._cfg.interprocess.platform = platform
@@ -145,33 +146,6 @@ class PortalRecorder:
         self._cfg.interprocess.manager_timeout_seconds = 30  # a loaded machine's broker can be slow to answer
         self._record = record
         self._clock = clock
-        self._listener: _PortalListener | None = None
-        self._lock = threading.Lock()
-        self._closing = False
-        self._thread = threading.Thread(target=self._run, name=f"{platform}-demo-portal", daemon=True)
-        self.error: BaseException | None = None
 
-    def _run(self) -> None:
-        try:
-            listener = _PortalListener(self._cfg, self._record, self._clock)
-            with self._lock:
-                self._listener = listener
-                if self._closing:
-                    listener.quit()
-            try:
-                listener.run()
-            finally:
-                listener.close()
-        except Exception as exc:  # reported by the demo; the thread must not die silently
-            self.error = exc
-            log.exception("portal recorder stopped")
-
-    def start(self) -> None:
-        self._thread.start()
-
-    def close(self) -> None:
-        with self._lock:
-            self._closing = True
-            if self._listener is not None:
-                self._listener.quit()
-        self._thread.join(timeout=15)
+    def _build(self) -> SimpleThread:
+        return _PortalListener(self._cfg, self._record, self._clock)

@@ -27,12 +27,8 @@ class _ConstantBehavior(Behavior):
     def set_specific_param(self, param: str, value: str) -> bool:
         if param == self.PARAM:
             self.desired = parse_float(value, param)
-        elif param == "peakwidth":
-            self.peakwidth = parse_float(value, param, low=0.0)
-        elif param == "basewidth":
-            self.basewidth = parse_float(value, param, low=0.0)
-        elif param == "summitdelta":
-            self.summitdelta = parse_float(value, param, low=0.0)
+        elif param in ("peakwidth", "basewidth", "summitdelta"):
+            setattr(self, param, parse_float(value, param, low=0.0))
         elif param == f"{self.PARAM}_mismatch_var":
             self.mismatch_var = value
         else:

@@ -34,12 +34,8 @@ class StationKeepBehavior(Behavior):
             self.station = parse_point(value)
         elif param == "center_activate":
             self.center_activate = parse_bool(value, param)
-        elif param == "inner_radius":
-            self.inner_radius = parse_float(value, param, low=0.0)
-        elif param == "outer_radius":
-            self.outer_radius = parse_float(value, param, low=0.0)
-        elif param == "outer_speed":
-            self.outer_speed = parse_float(value, param, low=0.0)
+        elif param in ("inner_radius", "outer_radius", "outer_speed"):
+            setattr(self, param, parse_float(value, param, low=0.0))
         elif param in ("transit_speed", "extra_speed"):
             self.transit_speed = parse_float(value, param, low=0.0)
         elif param == "swing_time":

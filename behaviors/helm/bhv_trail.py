@@ -56,24 +56,20 @@ class TrailBehavior(ContactBehavior):
     def set_specific_param(self, param: str, value: str) -> bool:
         if super().set_specific_param(param, value):
             return True
-        if param == "nm_radius":
-            self.nm_radius = parse_float(value, param, low=0.0)
+        if param in ("nm_radius", "radius", "trail_range"):
+            setattr(self, param, parse_float(value, param, low=0.0))
         elif param == "no_alert_request":
             self.no_alert_request = parse_bool(value, param)
         elif param in ("post_trail_dist_on_idle", "post_trail_distance_on_idle"):
             self.post_trail_dist_on_idle = parse_bool(value, param)
         elif param in ("pwt_outer_dist", "max_range"):  # max_range: the deprecated name
             self.pwt_outer_dist = parse_float(value, param, low=0.0)
-        elif param == "radius":
-            self.radius = parse_float(value, param, low=0.0)
         elif param == "trail_angle":
             self.trail_angle = angle180(parse_float(value, param))
         elif param == "trail_angle_type":
             if value.lower() not in ("absolute", "relative"):
                 raise ParamError(f"trail_angle_type must be relative or absolute, not '{value}'")
             self.angle_relative = value.lower() == "relative"
-        elif param == "trail_range":
-            self.trail_range = parse_float(value, param, low=0.0)
         else:
             return False
         return True

@@ -12,6 +12,7 @@ import yaml
 
 from launch.errors import LaunchError
 from launch.interfaces.model import LAYERS, ApplicationInterface, PubSubEntry, ThreadInfo
+from launch.textfile import read_text
 
 
 class InterfaceFileError(LaunchError, ValueError):
@@ -43,6 +44,16 @@ def _entry_lines(entry: PubSubEntry, indent: str, with_thread: bool) -> list[str
     return lines
 
 
+def _direction_lines(direction: str, entries: list[PubSubEntry], indent: str, with_thread: bool) -> list[str]:
+    """``publishes:``/``subscribes:`` and its entries one level deeper, or ``[]`` when there are none."""
+    if not entries:
+        return [f"{indent}{direction}: []"]
+    lines = [f"{indent}{direction}:"]
+    for entry in entries:
+        lines.extend(_entry_lines(entry, indent + "  ", with_thread))
+    return lines
+
+
 def dumps(interface: ApplicationInterface) -> str:
     """The interface as YAML text, layers outermost first, entries sorted as Goby sorts them."""
     lines = [f"application: {_scalar(interface.application)}"]
@@ -50,13 +61,7 @@ def dumps(interface: ApplicationInterface) -> str:
         lines.append(f"{layer}:")
         if layer != "interthread":
             for direction in ("publishes", "subscribes"):
-                entries = interface.layer_entries(layer, direction)
-                if entries:
-                    lines.append(f"  {direction}:")
-                    for entry in entries:
-                        lines.extend(_entry_lines(entry, "    ", with_thread=True))
-                else:
-                    lines.append(f"  {direction}: []")
+                lines.extend(_direction_lines(direction, interface.layer_entries(layer, direction), "  ", True))
             continue
         lines.append("  threads:")
         for name in sorted(interface.threads):
@@ -68,12 +73,7 @@ def dumps(interface: ApplicationInterface) -> str:
                 lines.extend(f"        - {_scalar(base)}" for base in info.bases)
             for direction in ("publishes", "subscribes"):
                 entries = [e for e in interface.layer_entries("interthread", direction) if e.thread == name]
-                if entries:
-                    lines.append(f"      {direction}:")
-                    for entry in entries:
-                        lines.extend(_entry_lines(entry, "        ", with_thread=False))
-                else:
-                    lines.append(f"      {direction}: []")
+                lines.extend(_direction_lines(direction, entries, "      ", False))
     return "\n".join(lines) + "\n"
 
 
@@ -136,8 +136,4 @@ def loads(text: str, where: str = "<string>") -> ApplicationInterface:
 def load(path: str | Path) -> ApplicationInterface:
     """Read an interface file."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise InterfaceFileError(f"{path}: cannot read: {exc.strerror}") from exc
-    return loads(text, str(path))
+    return loads(read_text(path, InterfaceFileError, "{path}: cannot read: {reason}"), str(path))

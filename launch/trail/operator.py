@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import logging
 import queue
-import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -27,6 +26,7 @@ from gateway.goby.intervehicle import Publisher
 from gateway.goby.portal import SimpleThread
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from launch.errors import MissionConfigError
+from launch.portal_thread import BackgroundPortalThread
 from launch.record import MissionRecord
 from launch.recorder import SimClock
 from launch.usv.shore import NO_SCHEDULE, ScheduledCommand, parse_schedule
@@ -87,10 +87,11 @@ class _Worker(SimpleThread):
             job(self)
 
 
-class PortalWorker:
+class PortalWorker(BackgroundPortalThread):
     """A ``_Worker`` on its own thread, attached to one platform's broker; ``submit(job)`` runs ``job(thread)`` there."""
 
     def __init__(self, platform: str, ipc_base: str, warp: int) -> None:
+        super().__init__(f"{platform}-demo-operator", log, "operator thread stopped")
         self._cfg = GobyMOOSGatewayConfig()
         self._cfg.app.name = f"trail-demo-{platform}"
         self._cfg.app.simulation.time.use_sim_time = True
@@ -100,39 +101,12 @@ class PortalWorker:
         self._cfg.interprocess.socket_name = ipc_base
         self._cfg.interprocess.manager_timeout_seconds = 30
         self._jobs: queue.Queue[Callable[[SimpleThread], None]] = queue.Queue()
-        self._worker: _Worker | None = None
-        self._lock = threading.Lock()
-        self._closing = False
-        self._thread = threading.Thread(target=self._run, name=f"{platform}-demo-operator", daemon=True)
-        self.error: BaseException | None = None
 
-    def _run(self) -> None:
-        try:
-            worker = _Worker(self._cfg, self._jobs)
-            with self._lock:
-                self._worker = worker
-                if self._closing:
-                    worker.quit()
-            try:
-                worker.run()
-            finally:
-                worker.close()
-        except Exception as exc:  # reported by the demo; the thread must not die silently
-            self.error = exc
-            log.exception("operator thread stopped")
-
-    def start(self) -> None:
-        self._thread.start()
+    def _build(self) -> SimpleThread:
+        return _Worker(self._cfg, self._jobs)
 
     def submit(self, job: Callable[[SimpleThread], None]) -> None:
         self._jobs.put(job)
-
-    def close(self) -> None:
-        with self._lock:
-            self._closing = True
-            if self._worker is not None:
-                self._worker.quit()
-        self._thread.join(timeout=15)
 
     def watch_node_status(self, record: MissionRecord, clock: SimClock) -> None:
         """File every NodeStatus on this platform's interprocess (the topside manager's output) by vehicle name."""

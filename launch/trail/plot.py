@@ -29,6 +29,16 @@ def _at(record: MissionRecord, t: float) -> tuple[float, float] | None:
     return None if sample is None else (sample.x, sample.y)
 
 
+def _finish_panel(axes: plt.Axes, xlabel: str, ylabel: str, title: str) -> None:
+    """Equal scales, labels, a light grid and the legend: both panels end the same way."""
+    axes.set_aspect("equal", adjustable="datalim")
+    axes.set_xlabel(xlabel)
+    axes.set_ylabel(ylabel)
+    axes.set_title(title)
+    axes.grid(True, linewidth=0.3)
+    axes.legend(loc="best", fontsize=8)
+
+
 def write_trail_png(path: Path, records: dict[str, MissionRecord], commands: list[CommandOutcome],
                     recovers: list[RecoverOutcome], trails: list[TrailPerformance], title: str) -> None:
     fig, (ax, rel) = plt.subplots(1, 2, figsize=(15, 7.5), dpi=100, gridspec_kw={"width_ratios": [1.35, 1]})
@@ -64,12 +74,7 @@ def write_trail_png(path: Path, records: dict[str, MissionRecord], commands: lis
     if recovers:
         ax.plot(*STATION, marker="*", markersize=16, color="gold", markeredgecolor="black", linestyle="none",
                 zorder=6, label="recovery station (100,-100)")
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("x (m east of origin)")
-    ax.set_ylabel("y (m north of origin)")
-    ax.set_title("tracks")
-    ax.grid(True, linewidth=0.3)
-    ax.legend(loc="best", fontsize=8)
+    _finish_panel(ax, "x (m east of origin)", "y (m north of origin)", "tracks")
 
     rel.plot(0, 0, marker="^", markersize=12, color="black", linestyle="none", label="USV (heading up)")
     for trail in trails:
@@ -84,12 +89,8 @@ def write_trail_png(path: Path, records: dict[str, MissionRecord], commands: lis
                  markeredgewidth=2, linestyle="none")
     circle = plt.Circle((0, 0), TRAIL_RANGE, fill=False, linestyle="--", linewidth=0.8, color="gray")
     rel.add_patch(circle)
-    rel.set_aspect("equal", adjustable="datalim")
-    rel.set_xlabel("starboard of the USV (m)")
-    rel.set_ylabel("ahead of the USV (m)")
-    rel.set_title("AUVs relative to the USV while trailing (+: trail points, 50 m)")
-    rel.grid(True, linewidth=0.3)
-    rel.legend(loc="best", fontsize=8)
+    _finish_panel(rel, "starboard of the USV (m)", "ahead of the USV (m)",
+                  "AUVs relative to the USV while trailing (+: trail points, 50 m)")
     fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path)

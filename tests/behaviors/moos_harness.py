@@ -25,9 +25,9 @@ IVP_HELM = Path(sys.executable).parent / "ivp-helm"
 
 def bhv_block(kind: str, **params: object) -> str:
     """One ``Behavior = BHV_<kind> { ... }`` block of a .bhv file: ``params`` in order, then ``duration =
-    no-time-limit`` unless a duration is given."""
+    no-time-limit`` unless a duration is given (``duration=None``: no duration line)."""
     params.setdefault("duration", "no-time-limit")
-    lines = "".join(f"  {name:<8} = {value}\n" for name, value in params.items())
+    lines = "".join(f"  {name:<8} = {value}\n" for name, value in params.items() if value is not None)
     return f"Behavior = BHV_{kind}\n{{\n{lines}}}\n"
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from .core_loop import CoreLoop, make_helm
 from .kinematic_vehicle import KinematicModel
-from .moos_harness import ring_stats
+from .moos_harness import bhv_block, ring_stats
 
 WAYPOINTS = """\
 initialize DEPLOY = false
@@ -163,38 +163,12 @@ def test_deploy_state_switches_behaviours(tmp_path: Path) -> None:
 
 
 def test_constant_behaviours_and_duration(tmp_path: Path) -> None:
-    text = """\
-initialize GO = true
-Behavior = BHV_ConstantHeading
-{
-  name = hdg
-  condition = GO = true
-  heading = 271.6
-  duration = no-time-limit
-}
-Behavior = BHV_ConstantSpeed
-{
-  name = spd
-  condition = GO = true
-  speed = 1.3
-  duration = 10
-  endflag = SPD_DONE = true
-}
-Behavior = BHV_ConstantDepth
-{
-  name = dep
-  condition = GO = true
-  depth = 12
-  duration = no-time-limit
-}
-Behavior = BHV_ConstantSpeed
-{
-  name = once
-  pwt = 0
-  condition = GO = true
-  endflag = ONCE = true
-}
-"""
+    text = "initialize GO = true\n" + "".join([
+        bhv_block("ConstantHeading", name="hdg", condition="GO = true", heading=271.6),
+        bhv_block("ConstantSpeed", name="spd", condition="GO = true", speed=1.3, duration=10, endflag="SPD_DONE = true"),
+        bhv_block("ConstantDepth", name="dep", condition="GO = true", depth=12),
+        bhv_block("ConstantSpeed", name="once", pwt=0, condition="GO = true", endflag="ONCE = true", duration=None),
+    ])
     helm = make_helm(tmp_path, text, domains=("course:0:359:360", "speed:0:4:41", "depth:0:100:101"),
                      start_engaged="true")
     loop = CoreLoop(helm)

@@ -36,14 +36,23 @@ def write_config(path: Path, port: int, **frontseat: object) -> Path:
     return path
 
 
-def start_interface(tmp_path: Path, broker, cfg: Path, name: str = "iface") -> ChildProcess:
+def start_interface(tmp_path: Path, broker, cfg: Path, name: str = "iface", driver: str = "basic_simulator",
+                    flags: tuple[str, ...] = ("-vv",)) -> ChildProcess:
     env = broker.env()
-    env["FRONTSEAT_DRIVER_LIBRARY"] = "basic_simulator"
+    env["FRONTSEAT_DRIVER_LIBRARY"] = driver
     return app_process(
-        [sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg), "-vv"],
+        [sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg), *flags],
         env=env,
         log_path=tmp_path / f"{name}.log",
     )
+
+
+def exit_code(iface: ChildProcess, timeout: float = 60) -> int:
+    """The exit status of an interface expected to quit by itself; it is stopped whatever happens."""
+    try:
+        return iface.wait(timeout)
+    finally:
+        iface.stop()
 
 
 class ScriptedHelm:
@@ -204,11 +213,7 @@ def test_exit_on_error_quits_with_code_zero(tmp_path: Path) -> None:
                            frontseat_connected_timeout=2)
         cfg.write_text(cfg.read_text().replace("frontseat_cfg {", "frontseat_cfg {\n  exit_on_error: true"))
         iface = start_interface(tmp_path, broker, cfg)
-        try:
-            code = iface.wait(60)
-        finally:
-            iface.stop()
-        assert code == 0
+        assert exit_code(iface) == 0
         assert "exit_on_error" in iface.stderr_text()
 
 
@@ -263,13 +268,6 @@ def test_a_driver_factory_that_raises_exits_1_promptly(tmp_path: Path) -> None:
     with broker_process(tmp_path, platform="usv") as broker:
         cfg = tmp_path / "fs.pb.cfg"
         cfg.write_text("frontseat_cfg { require_helm: false }\n")  # this driver has no config extension
-        env = broker.env()
-        env["FRONTSEAT_DRIVER_LIBRARY"] = str(driver)
-        iface = app_process([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg)], env=env,
-                           log_path=tmp_path / "iface.log")
-        try:
-            code = iface.wait(60)
-        finally:
-            iface.stop()
-        assert code == 1
+        iface = start_interface(tmp_path, broker, cfg, driver=str(driver), flags=())
+        assert exit_code(iface) == 1
         assert "no vehicle attached" in iface.stderr_text()

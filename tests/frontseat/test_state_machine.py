@@ -61,17 +61,22 @@ def make(require_helm: bool = True, **fields: float) -> tuple[ScriptedDriverDoub
     return ScriptedDriverDouble(cfg, clock), clock
 
 
+def state_after_work(d: ScriptedDriverDouble, passes: int = 1) -> int:
+    """``passes`` calls of ``do_work()``, then the interface state."""
+    for _ in range(passes):
+        d.do_work()
+    return d.state()
+
+
 def to_listen(d: ScriptedDriverDouble) -> None:
     d.fs_state, d.providing = fs.FRONTSEAT_ACCEPTING_COMMANDS, True
-    d.do_work()
-    assert d.state() == fs.INTERFACE_LISTEN
+    assert state_after_work(d) == fs.INTERFACE_LISTEN
 
 
 def to_command(d: ScriptedDriverDouble) -> None:
     to_listen(d)
     d.set_helm_state(fs.HELM_DRIVE)
-    d.do_work()
-    assert d.state() == fs.INTERFACE_COMMAND
+    assert state_after_work(d) == fs.INTERFACE_COMMAND
 
 
 def test_initial_status_has_no_errors() -> None:
@@ -90,10 +95,8 @@ def test_standby_to_listen_on_data_then_command_on_next_tick_never_same_tick() -
     d, _ = make()
     d.set_helm_state(fs.HELM_DRIVE)
     d.fs_state, d.providing = fs.FRONTSEAT_ACCEPTING_COMMANDS, True
-    d.do_work()
-    assert d.state() == fs.INTERFACE_LISTEN
-    d.do_work()
-    assert d.state() == fs.INTERFACE_COMMAND
+    assert state_after_work(d) == fs.INTERFACE_LISTEN
+    assert state_after_work(d) == fs.INTERFACE_COMMAND
     assert d.loop_calls == 2
 
 
@@ -101,27 +104,22 @@ def test_standby_with_data_skips_error_checks_even_when_parked() -> None:
     d, _ = make()
     d.set_helm_state(fs.HELM_PARK)
     d.fs_state, d.providing = fs.FRONTSEAT_IDLE, True
-    d.do_work()
-    assert d.state() == fs.INTERFACE_LISTEN  # no check this tick
-    d.do_work()
-    assert d.state() == fs.INTERFACE_HELM_ERROR
+    assert state_after_work(d) == fs.INTERFACE_LISTEN  # no check this tick
+    assert state_after_work(d) == fs.INTERFACE_HELM_ERROR
     assert d.last_helm_error() == fs.ERROR_HELM_PARKED
 
 
 def test_listen_to_command_without_helm_when_not_required() -> None:
     d, _ = make(require_helm=False)
     to_listen(d)
-    d.do_work()
-    assert d.state() == fs.INTERFACE_COMMAND
+    assert state_after_work(d) == fs.INTERFACE_COMMAND
 
 
 def test_listen_stays_when_frontseat_not_accepting() -> None:
     d, _ = make()
     d.set_helm_state(fs.HELM_DRIVE)
     d.fs_state, d.providing = fs.FRONTSEAT_IN_CONTROL, True
-    for _ in range(5):
-        d.do_work()
-    assert d.state() == fs.INTERFACE_LISTEN
+    assert state_after_work(d, 5) == fs.INTERFACE_LISTEN
 
 
 def test_listen_to_command_skips_error_checks_even_if_data_stopped() -> None:
@@ -129,10 +127,8 @@ def test_listen_to_command_skips_error_checks_even_if_data_stopped() -> None:
     to_listen(d)
     d.set_helm_state(fs.HELM_DRIVE)
     d.providing = False
-    d.do_work()
-    assert d.state() == fs.INTERFACE_COMMAND
-    d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d) == fs.INTERFACE_COMMAND
+    assert state_after_work(d) == fs.INTERFACE_FS_ERROR
     assert d.last_frontseat_error() == fs.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
 
 
@@ -143,8 +139,7 @@ def test_command_to_listen_when_frontseat_idle_or_in_control_whatever_the_helm(f
     to_command(d)
     d.fs_state = fs_state
     d.set_helm_state(helm)
-    d.do_work()
-    assert d.state() == fs.INTERFACE_LISTEN
+    assert state_after_work(d) == fs.INTERFACE_LISTEN
 
 
 def test_command_helm_not_running_is_immediate_error_when_required() -> None:
@@ -159,11 +154,9 @@ def test_command_helm_not_running_is_immediate_error_when_required() -> None:
 def test_command_helm_not_running_is_fine_when_not_required() -> None:
     d, clock = make(require_helm=False)
     to_listen(d)
-    d.do_work()
-    assert d.state() == fs.INTERFACE_COMMAND
+    assert state_after_work(d) == fs.INTERFACE_COMMAND
     clock.t += 100
-    d.do_work()
-    assert d.state() == fs.INTERFACE_COMMAND
+    assert state_after_work(d) == fs.INTERFACE_COMMAND
 
 
 @pytest.mark.parametrize("where", ["standby", "listen", "command"])
@@ -178,8 +171,7 @@ def test_helm_park_is_an_error_in_standby_listen_and_command(where: str, require
     else:
         to_command(d)
     d.set_helm_state(fs.HELM_PARK)
-    d.do_work()
-    assert d.state() == fs.INTERFACE_HELM_ERROR
+    assert state_after_work(d) == fs.INTERFACE_HELM_ERROR
     assert d.last_helm_error() == fs.ERROR_HELM_PARKED
 
 
@@ -187,16 +179,13 @@ def test_helm_error_clears_only_on_drive() -> None:
     d, _ = make()
     d.fs_state = fs.FRONTSEAT_IDLE
     d.set_helm_state(fs.HELM_PARK)
-    d.do_work()
-    assert d.state() == fs.INTERFACE_HELM_ERROR
+    assert state_after_work(d) == fs.INTERFACE_HELM_ERROR
     d.set_helm_state(fs.HELM_NOT_RUNNING)
     d.providing = True
     for _ in range(3):
-        d.do_work()
-        assert d.state() == fs.INTERFACE_HELM_ERROR
+        assert state_after_work(d) == fs.INTERFACE_HELM_ERROR
     d.set_helm_state(fs.HELM_DRIVE)
-    d.do_work()
-    assert d.state() == fs.INTERFACE_STANDBY
+    assert state_after_work(d) == fs.INTERFACE_STANDBY
     assert not d.status().HasField("helm_error")
 
 
@@ -205,11 +194,9 @@ def test_standby_helm_not_running_only_strictly_after_timeout() -> None:
     start = clock.t
     d.fs_state = fs.FRONTSEAT_IDLE
     clock.t = start + TIMEOUT  # equal: the comparison is strict
-    d.do_work()
-    assert d.state() == fs.INTERFACE_STANDBY
+    assert state_after_work(d) == fs.INTERFACE_STANDBY
     clock.t = start + TIMEOUT + 1e-3
-    d.do_work()
-    assert d.state() == fs.INTERFACE_HELM_ERROR
+    assert state_after_work(d) == fs.INTERFACE_HELM_ERROR
     assert d.last_helm_error() == fs.ERROR_HELM_NOT_RUNNING
 
 
@@ -217,8 +204,7 @@ def test_standby_helm_not_running_never_an_error_when_not_required() -> None:
     d, clock = make(require_helm=False)
     d.fs_state = fs.FRONTSEAT_IDLE
     clock.t += 1000
-    d.do_work()
-    assert d.state() == fs.INTERFACE_STANDBY
+    assert state_after_work(d) == fs.INTERFACE_STANDBY
 
 
 def test_listen_helm_not_running_after_timeout_counted_from_start() -> None:
@@ -227,22 +213,18 @@ def test_listen_helm_not_running_after_timeout_counted_from_start() -> None:
     to_listen(d)  # entered LISTEN at start+5; the timeout still counts from start
     d.fs_state = fs.FRONTSEAT_IN_CONTROL
     clock.t += 4
-    d.do_work()
-    assert d.state() == fs.INTERFACE_LISTEN
+    assert state_after_work(d) == fs.INTERFACE_LISTEN
     clock.t += 1.5
-    d.do_work()
-    assert d.state() == fs.INTERFACE_HELM_ERROR
+    assert state_after_work(d) == fs.INTERFACE_HELM_ERROR
 
 
 def test_standby_not_connected_only_after_timeout() -> None:
     d, clock = make(frontseat_connected_timeout=TIMEOUT)
     d.set_helm_state(fs.HELM_DRIVE)
     clock.t += TIMEOUT
-    d.do_work()
-    assert d.state() == fs.INTERFACE_STANDBY
+    assert state_after_work(d) == fs.INTERFACE_STANDBY
     clock.t += 0.01
-    d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d) == fs.INTERFACE_FS_ERROR
     assert d.status().frontseat_error == fs.ERROR_FRONTSEAT_NOT_CONNECTED
 
 
@@ -253,11 +235,9 @@ def test_not_connected_is_immediate_in_listen_and_command(where: str) -> None:
     to_listen(d) if where == "listen" else to_command(d)
     if where == "listen":
         d.fs_state = fs.FRONTSEAT_IN_CONTROL
-        d.do_work()
-        assert d.state() == fs.INTERFACE_LISTEN
+        assert state_after_work(d) == fs.INTERFACE_LISTEN
     d.fs_state = fs.FRONTSEAT_NOT_CONNECTED
-    d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d) == fs.INTERFACE_FS_ERROR
     assert d.last_frontseat_error() == fs.ERROR_FRONTSEAT_NOT_CONNECTED
 
 
@@ -265,13 +245,10 @@ def test_not_connected_clears_when_connected_again() -> None:
     d, clock = make()
     d.set_helm_state(fs.HELM_DRIVE)
     clock.t += 2 * TIMEOUT
-    d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
-    d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d) == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d) == fs.INTERFACE_FS_ERROR
     d.fs_state = fs.FRONTSEAT_IDLE
-    d.do_work()
-    assert d.state() == fs.INTERFACE_STANDBY
+    assert state_after_work(d) == fs.INTERFACE_STANDBY
     assert not d.status().HasField("frontseat_error")
 
 
@@ -282,16 +259,12 @@ def test_not_providing_data_in_listen_and_command_clears_when_data_returns(where
     if where == "listen":
         d.fs_state = fs.FRONTSEAT_IN_CONTROL
     d.providing = False
-    d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d) == fs.INTERFACE_FS_ERROR
     assert d.last_frontseat_error() == fs.ERROR_FRONTSEAT_NOT_PROVIDING_DATA
-    d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d) == fs.INTERFACE_FS_ERROR
     d.providing = True
-    d.do_work()
-    assert d.state() == fs.INTERFACE_STANDBY
-    d.do_work()
-    assert d.state() == fs.INTERFACE_LISTEN
+    assert state_after_work(d) == fs.INTERFACE_STANDBY
+    assert state_after_work(d) == fs.INTERFACE_LISTEN
 
 
 def test_not_providing_data_never_raised_in_standby() -> None:
@@ -311,15 +284,13 @@ def test_not_connected_error_is_not_cleared_by_data_alone() -> None:
     d.do_work()
     assert d.last_frontseat_error() == fs.ERROR_FRONTSEAT_NOT_CONNECTED
     d.providing = True  # still NOT_CONNECTED
-    d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d) == fs.INTERFACE_FS_ERROR
 
 
 def test_helm_error_has_priority_over_frontseat_error() -> None:
     d, clock = make()
     clock.t += 2 * TIMEOUT  # both timeouts passed: helm NOT_RUNNING and fs NOT_CONNECTED both hold
-    d.do_work()
-    assert d.state() == fs.INTERFACE_HELM_ERROR
+    assert state_after_work(d) == fs.INTERFACE_HELM_ERROR
     assert d.last_frontseat_error() == fs.ERROR_FRONTSEAT_NONE
 
 
@@ -335,12 +306,9 @@ def test_ignoring_commands_from_loop_never_clears_and_skips_nothing_else() -> No
     d, _ = make()
     to_command(d)
     d.raise_in_loop = FrontSeatErrorException(fs.ERROR_FRONTSEAT_IGNORING_COMMANDS)
-    d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d) == fs.INTERFACE_FS_ERROR
     assert d.status().frontseat_error == fs.ERROR_FRONTSEAT_IGNORING_COMMANDS
-    for _ in range(5):
-        d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d, 5) == fs.INTERFACE_FS_ERROR
 
 
 def test_helm_error_raised_by_loop_from_an_error_state_keeps_the_stale_fs_error() -> None:
@@ -360,8 +328,7 @@ def test_a_raising_check_skips_loop_on_that_tick() -> None:
     to_command(d)
     calls = d.loop_calls
     d.set_helm_state(fs.HELM_PARK)
-    d.do_work()
-    assert d.state() == fs.INTERFACE_HELM_ERROR
+    assert state_after_work(d) == fs.INTERFACE_HELM_ERROR
     assert d.loop_calls == calls
     d.do_work()  # HELM_ERROR does no checks: loop runs
     assert d.loop_calls == calls + 1
@@ -395,8 +362,7 @@ def test_at_most_one_transition_per_tick_through_a_full_recovery() -> None:
     d, clock = make()
     d.set_helm_state(fs.HELM_DRIVE)
     clock.t += 2 * TIMEOUT
-    d.do_work()
-    assert d.state() == fs.INTERFACE_FS_ERROR
+    assert state_after_work(d) == fs.INTERFACE_FS_ERROR
     d.fs_state, d.providing = fs.FRONTSEAT_ACCEPTING_COMMANDS, True
     states = []
     for _ in range(3):

@@ -14,31 +14,27 @@ from launch.interfaces.visualize import VizOptions, build_graph
 FS = "goby::middleware::frontseat::"
 PB = "goby::middleware::frontseat::protobuf::"
 
+
+def _frontseat(direction: str, *names: str) -> set[tuple[str, str, str]]:
+    """``(direction, group, type)`` for frontseat groups, each name ``group:Type`` (type in the protobuf package)."""
+    return {(direction, FS + group, PB + type_name) for group, type_name in (n.split(":") for n in names)}
+
+
 # goby_frontseat_interface's interprocess interface (goby_frontseat.md §4.3): (direction, group, type), all PROTOBUF.
-ORIGINAL_FRONTSEAT_INTERFACE = {
-    ("subscribes", FS + "helm_state", PB + "HelmStateReport"),
-    ("subscribes", FS + "command_request", PB + "CommandRequest"),
-    ("subscribes", FS + "desired_course", PB + "DesiredCourse"),
-    ("subscribes", FS + "data_to_frontseat", PB + "InterfaceData"),
-    ("subscribes", FS + "raw_send_request", PB + "Raw"),
-    ("subscribes", "goby::datum_update", "goby::middleware::protobuf::DatumUpdate"),
-    ("publishes", FS + "command_response", PB + "CommandResponse"),
-    ("publishes", FS + "data_from_frontseat", PB + "InterfaceData"),
-    ("publishes", FS + "node_status", PB + "NodeStatus"),
-    ("publishes", FS + "raw_in", PB + "Raw"),
-    ("publishes", FS + "raw_out", PB + "Raw"),
-    ("publishes", FS + "status", PB + "InterfaceStatus"),
+ORIGINAL_FRONTSEAT_INTERFACE = (
+    _frontseat("subscribes", "helm_state:HelmStateReport", "command_request:CommandRequest",
+               "desired_course:DesiredCourse", "data_to_frontseat:InterfaceData", "raw_send_request:Raw")
+    | {("subscribes", "goby::datum_update", "goby::middleware::protobuf::DatumUpdate")}
+    | _frontseat("publishes", "command_response:CommandResponse", "data_from_frontseat:InterfaceData",
+                 "node_status:NodeStatus", "raw_in:Raw", "raw_out:Raw", "status:InterfaceStatus")
     # Goby's application base class announces the configuration at start
-    ("publishes", "goby::configuration", "goby::apps::zeromq::protobuf::FrontSeatInterfaceConfig"),
-}
+    | {("publishes", "goby::configuration", "goby::apps::zeromq::protobuf::FrontSeatInterfaceConfig")}
+)
 # The embedded FrontSeatTranslation (the moos_helm block; Goby's interface file lists it in goby_frontseat_interface
 # too): Goby3's frontseat_gateway_plugin.h/.cpp subscribe node_status and publish helm_state and desired_course;
 # ours also follows datum updates (docs/translators.md).
-ORIGINAL_FRONTSEAT_TRANSLATION = {
-    ("subscribes", FS + "node_status", PB + "NodeStatus"),
-    ("publishes", FS + "helm_state", PB + "HelmStateReport"),
-    ("publishes", FS + "desired_course", PB + "DesiredCourse"),
-}
+ORIGINAL_FRONTSEAT_TRANSLATION = _frontseat("subscribes", "node_status:NodeStatus") | _frontseat(
+    "publishes", "helm_state:HelmStateReport", "desired_course:DesiredCourse")
 
 
 def test_frontseat_interface_matches_the_original() -> None:

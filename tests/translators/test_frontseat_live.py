@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 
 import pytest
 
@@ -38,6 +39,17 @@ def node_status(stamp: float) -> NodeStatus:
     status.local_fix.x = 9999.0  # a wrong local fix: NAV_X/NAV_Y must come from lat/lon on the datum's grid
     status.local_fix.y = 9999.0
     return status
+
+
+def post_until(client: PortalClient, arrived: Callable[[], bool], post: Callable[[], None], what: str,
+               logs: Callable[[], str] = str) -> None:
+    """``post()`` every half second until ``arrived()``: the gateway registers for MOOS variables some time after
+    it connects, so the first posts may be lost."""
+    deadline = time.monotonic() + TIMEOUT_S
+    while not arrived():
+        assert time.monotonic() < deadline, f"no {what} arrived\n{logs()}"
+        post()
+        client.poll_until(arrived, 0.5)
 
 
 def test_node_status_becomes_nav_variables_and_a_node_report(stack):
@@ -83,11 +95,8 @@ def test_desired_setpoints_become_desired_course_with_goby_fallback(stack):
         courses: list[DesiredCourse] = client.collect(groups.desired_course, DesiredCourse)
         assert client.wait_subscribed()
         # Readiness: DESIRED_SPEED alone until a course comes back (the gateway registered for it by then).
-        deadline = time.monotonic() + TIMEOUT_S
-        while not any(c.time == 100.0 for c in courses):
-            assert time.monotonic() < deadline, f"no desired_course arrived\n{stack.logs()}"
-            helm.notify("DESIRED_SPEED", 0.5, time=100.0)
-            client.poll_until(lambda: any(c.time == 100.0 for c in courses), 0.5)
+        post_until(client, lambda: any(c.time == 100.0 for c in courses),
+                   lambda: helm.notify("DESIRED_SPEED", 0.5, time=100.0), "desired_course", stack.logs)
 
         helm.notify("DESIRED_HEADING", 270.0, time=200.0)
         helm.notify("DESIRED_DEPTH", 12.0, time=200.0)
@@ -114,11 +123,8 @@ def test_ivphelm_state_becomes_helm_state(stack):
             PortalClient(stack.broker.interprocess_config(), name="interface_helm") as client:
         reports: list[HelmStateReport] = client.collect(groups.helm_state, HelmStateReport)
         assert client.wait_subscribed()
-        deadline = time.monotonic() + TIMEOUT_S
-        while not reports:
-            assert time.monotonic() < deadline, f"no helm_state arrived\n{stack.logs()}"
-            helm.notify("IVPHELM_STATE", "STANDBY")
-            client.poll_until(lambda: bool(reports), 0.5)
+        post_until(client, lambda: bool(reports), lambda: helm.notify("IVPHELM_STATE", "STANDBY"), "helm_state",
+                   stack.logs)
         for value in ("DRIVE", " park ", "DRIVE+", "drive", "MALCONFIG"):
             helm.notify("IVPHELM_STATE", value)
         expected = [HELM_DRIVE, HELM_PARK, HELM_NOT_RUNNING, HELM_DRIVE, HELM_NOT_RUNNING]
@@ -137,13 +143,13 @@ def test_a_string_setpoint_is_reported_and_the_translator_keeps_serving(tmp_path
             PortalClient(broker.interprocess_config(), name="interface_bad") as client:
         courses: list[DesiredCourse] = client.collect(groups.desired_course, DesiredCourse)
         assert client.wait_subscribed()
-        deadline = time.monotonic() + TIMEOUT_S
-        while not any(c.time == 300.0 for c in courses):
-            assert time.monotonic() < deadline, "no desired_course arrived"
+
+        def post_setpoints() -> None:
             helm.notify("DESIRED_HEADING", "north", time=299.0)
             helm.notify("DESIRED_DEPTH", 4.0, time=299.0)
             helm.notify("DESIRED_SPEED", 0.75, time=300.0)
-            client.poll_until(lambda: any(c.time == 300.0 for c in courses), 0.5)
+
+        post_until(client, lambda: any(c.time == 300.0 for c in courses), post_setpoints, "desired_course")
     course = next(c for c in courses if c.time == 300.0)
     assert course.speed == 0.75 and course.depth == 4.0 and not course.HasField("heading")
     assert "DESIRED_HEADING must be a number, got the string 'north' from 'sloppy_helm'" in caplog.text

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import re
 import struct
+from collections.abc import Callable
 
 from google.protobuf.descriptor import FieldDescriptor
 
@@ -44,22 +45,22 @@ def _g(value: float, precision: int) -> str:
 
 def simple_dtoa(value: float) -> str:
     """Protobuf C++ ``SimpleDtoa`` (text format doubles): ``%.15g``, or ``%.17g`` if that does not round-trip."""
-    if math.isnan(value):
-        return "nan"
-    if math.isinf(value):
-        return "inf" if value > 0 else "-inf"
-    short = f"{value:.15g}"
-    return short if float(short) == value else f"{value:.17g}"
+    return _round_trip(value, 15, 17, float)
 
 
 def simple_ftoa(value: float) -> str:
     """Protobuf C++ ``SimpleFtoa`` (text format floats): ``%.6g``, or ``%.9g`` if that does not round-trip."""
+    return _round_trip(value, 6, 9, _as_float32)
+
+
+def _round_trip(value: float, short_digits: int, long_digits: int, stored: Callable[[float], float]) -> str:
+    """``%.<short>g`` if it reads back as the same ``stored`` value, else ``%.<long>g``; nan/inf as protobuf."""
     if math.isnan(value):
         return "nan"
     if math.isinf(value):
         return "inf" if value > 0 else "-inf"
-    short = f"{value:.6g}"
-    return short if _as_float32(float(short)) == _as_float32(value) else f"{value:.9g}"
+    short = f"{value:.{short_digits}g}"
+    return short if stored(float(short)) == stored(value) else f"{value:.{long_digits}g}"
 
 
 def _as_float32(value: float) -> float:

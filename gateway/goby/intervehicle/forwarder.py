@@ -235,24 +235,23 @@ class InterVehicleForwarder:
         if pending is None or pair.data.header.src in pending.acked_by:
             return
         pending.acked_by.add(pair.data.header.src)
-        if pending.on_ack is None:
-            return
-        try:
-            pending.on_ack(pending.msg, pair.data)
-        except Exception:
-            log.exception("%s: ack callback raised; continuing", self._thread_name)
+        self._report(pending.on_ack, pending.msg, pair.data, "ack")
 
     def _on_expire(self, pair: ExpireMessagePair) -> None:
         pending = self._pending.get(self._key_of(pair.serializer))
         if pending is None or pending.expired:
             return
         pending.expired = True  # reported once; an ack from another link may still come
-        if pending.on_expire is None:
+        self._report(pending.on_expire, pending.msg, pair.data, "expire")
+
+    def _report(self, callback: Callable[[Any, Any], None] | None, msg: Any, data: Any, what: str) -> None:
+        """Call a publisher's ack or expire callback, if it gave one; an exception in it is logged."""
+        if callback is None:
             return
         try:
-            pending.on_expire(pending.msg, pair.data)
+            callback(msg, data)
         except Exception:
-            log.exception("%s: expire callback raised; continuing", self._thread_name)
+            log.exception("%s: %s callback raised; continuing", self._thread_name, what)
 
     def _on_report(self, report: SubscriptionReport) -> None:
         """A report without ``changed`` announces a (re)started link: send our subscriptions again."""

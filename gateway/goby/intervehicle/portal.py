@@ -30,7 +30,7 @@ from gateway.goby.intervehicle.protobuf.intervehicle_pb2 import (
     SubscriptionReport,
 )
 from gateway.goby.intervehicle.protobuf.serializer_transporter_pb2 import SerializerTransporterMessage
-from gateway.goby.portal.context import ProcessContext, current_context, use_context
+from gateway.goby.portal.context import ProcessContext, current_context, start_on_thread
 from gateway.goby.portal.group import Group
 from gateway.goby.portal.thread import SimpleThread
 
@@ -152,40 +152,31 @@ class IntervehiclePortal:
 
     def _start_link(self, cfg: LinkConfig) -> None:
         driver = self._factory(cfg.driver)
-        started = threading.Event()
-        box: dict[str, object] = {}
 
-        def target() -> None:
-            with use_context(self.context):
-                thread: LinkThread | None = None
-                try:
-                    thread = LinkThread(cfg, driver)
-                    thread.initialize()
-                except BaseException as exc:  # noqa: BLE001 - reported to start()
-                    if thread is not None:
-                        thread.close()
-                    box["error"] = exc
-                    started.set()
-                    return
-                box["thread"] = thread
-                started.set()
-                try:
-                    while thread.alive:
-                        thread.run_once()
-                except Exception:
-                    log.exception("link %d failed", cfg.modem_id)
-                finally:
-                    thread.finalize()
-                    thread.close()
+        def build() -> LinkThread:
+            thread = LinkThread(cfg, driver)
+            try:
+                thread.initialize()
+            except BaseException:
+                thread.close()
+                raise
+            return thread
 
-        pythread = threading.Thread(target=target, name=f"intervehicle-link-{cfg.modem_id}")
-        pythread.start()
-        started.wait()
-        if "error" in box:
-            pythread.join()
-            exc = box["error"]
-            raise AcommsError(f"intervehicle link {cfg.modem_id}: {exc}") from exc  # type: ignore[misc]
-        self._threads.append((box["thread"], pythread))  # type: ignore[arg-type]
+        def run(thread: LinkThread) -> None:
+            try:
+                while thread.alive:
+                    thread.run_once()
+            except Exception:
+                log.exception("link %d failed", cfg.modem_id)
+            finally:
+                thread.finalize()
+                thread.close()
+
+        try:
+            started = start_on_thread(self.context, build, run, f"intervehicle-link-{cfg.modem_id}")
+        except BaseException as exc:  # reported to start()
+            raise AcommsError(f"intervehicle link {cfg.modem_id}: {exc}") from exc
+        self._threads.append(started)
         log.info("intervehicle link %d up (subnet mask 0x%X, %d slot(s))", cfg.modem_id, cfg.subnet_mask,
                  len(cfg.mac.slot))
 

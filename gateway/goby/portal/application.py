@@ -9,7 +9,7 @@ from typing import Any
 
 from google.protobuf.message import Message
 
-from gateway.goby.portal.context import use_context
+from gateway.goby.portal.context import start_on_thread
 from gateway.goby.portal.errors import ThreadError
 from gateway.goby.portal.group import Group
 from gateway.goby.portal.thread import SimpleThread, interprocess_config_of
@@ -71,34 +71,21 @@ class MultiThreadApplication(_Application):
         """
         if not args and not kwargs:
             args = (self.cfg(),)
-        constructed = threading.Event()
-        box: dict[str, Any] = {}
 
-        def target() -> None:
-            with use_context(self.context):
-                try:
-                    instance = thread_class(*args, **kwargs)
-                except BaseException as exc:  # noqa: BLE001 - reported to the launcher
-                    box["error"] = exc
-                    constructed.set()
-                    return
-                box["thread"] = instance
-                constructed.set()
-                try:
-                    instance.run()
-                except Exception:
-                    log.exception("thread %s failed; quitting the application", thread_class.__qualname__)
-                    self.quit(1)
-                finally:
-                    instance.close()
+        def run(instance: SimpleThread) -> None:
+            try:
+                instance.run()
+            except Exception:
+                log.exception("thread %s failed; quitting the application", thread_class.__qualname__)
+                self.quit(1)
+            finally:
+                instance.close()
 
-        pythread = threading.Thread(target=target, name=thread_class.__qualname__)
-        pythread.start()
-        constructed.wait()
-        if "error" in box:
-            pythread.join()
-            raise ThreadError(f"{thread_class.__qualname__} failed to start: {box['error']}") from box["error"]
-        instance: SimpleThread = box["thread"]
+        try:
+            instance, pythread = start_on_thread(self.context, lambda: thread_class(*args, **kwargs), run,
+                                                 thread_class.__qualname__)
+        except BaseException as exc:
+            raise ThreadError(f"{thread_class.__qualname__} failed to start: {exc}") from exc
         with self._threads_lock:
             self._threads.append((instance, pythread))
         log.debug("launched thread %s", thread_class.__qualname__)

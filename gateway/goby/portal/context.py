@@ -13,9 +13,9 @@ import os
 import sys
 import threading
 import weakref
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any
+from typing import Any, TypeVar
 
 import zmq
 
@@ -147,3 +147,37 @@ def use_context(context: ProcessContext) -> Iterator[ProcessContext]:
         yield context
     finally:
         _current.context = previous
+
+
+T = TypeVar("T")
+
+
+def start_on_thread(context: ProcessContext, build: Callable[[], T], run: Callable[[T], None],
+                    name: str) -> tuple[T, threading.Thread]:
+    """Call ``build()`` on a new Python thread under ``context`` (so what it creates belongs to that thread), then
+    ``run(built)`` there; returns once ``build`` has finished, with what it built and the thread.
+
+    If ``build`` raises, the thread ends and the exception is raised here.
+    """
+    built = threading.Event()
+    box: dict[str, Any] = {}
+
+    def target() -> None:
+        with use_context(context):
+            try:
+                obj = build()
+            except BaseException as exc:  # noqa: BLE001 - raised again on the starting thread
+                box["error"] = exc
+                built.set()
+                return
+            box["built"] = obj
+            built.set()
+            run(obj)
+
+    pythread = threading.Thread(target=target, name=name)
+    pythread.start()
+    built.wait()
+    if "error" in box:
+        pythread.join()
+        raise box["error"]
+    return box["built"], pythread
