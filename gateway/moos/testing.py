@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import shutil
+import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterable, Iterator
@@ -43,6 +45,22 @@ def real_moos_skip_reason(*binaries: str) -> str | None:
     if not private_netns():
         return "the real MOOSDB listens on all addresses; run inside a private network namespace (netns-run)"
     return None
+
+
+COURSE_IVP_RELEASE = "19.8"  # the MOOS-IvP release ivp-helm follows (the Goby3 course's)
+
+
+def ivp_release(binary: str = "pHelmIvP") -> str | None:
+    """The MOOS-IvP release a real binary reports (``Version 19.8`` -> ``"19.8"``), or None if it says none.
+
+    Comparisons of release-specific details (flag macros, BHV_Trail's geometry) hold for ``COURSE_IVP_RELEASE``.
+    """
+    try:
+        text = subprocess.run([binary, "--version"], capture_output=True, text=True, timeout=10).stdout
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    match = re.search(r"Version\s+([0-9][0-9.]*[0-9])", text)
+    return match.group(1) if match else None
 
 
 @contextlib.contextmanager

@@ -19,7 +19,13 @@ from google.protobuf.message import DecodeError
 
 from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
 from gateway.goby.acomms.udp_multicast import join_multicast
-from launch.trail.settings import MULTICAST_ADDRESS, TrailSettings, acomms_mac_slots, satellite_mac_slots
+from launch.trail.settings import (
+    LINK_LISTEN_ADDRESS,
+    MULTICAST_ADDRESS,
+    TrailSettings,
+    acomms_mac_slots,
+    satellite_mac_slots,
+)
 
 log = logging.getLogger(__name__)
 MAX_DATAGRAM = 65535
@@ -113,6 +119,6 @@ def _count(stats: LinkStats, datagram: bytes) -> None:
 
 def _listen(group: str, port: int) -> socket.socket:
     """A non-blocking UDP socket joined to ``group:port`` (as the modem driver's, without sending)."""
-    sock = join_multicast(group, port)
+    sock = join_multicast(group, port, interface=LINK_LISTEN_ADDRESS)
     sock.setblocking(False)
     return sock

@@ -40,6 +40,7 @@ TOPSIDE_VEHICLE_ID = 0
 SATELLITE_SLOT = (5, 64)  # slot_seconds, max_frame_bytes (post-homework2 onward)
 ACOMMS_SLOT = (10, 128)
 MULTICAST_ADDRESS = "239.142.0.2"
+LINK_LISTEN_ADDRESS = "127.0.0.1"  # the course leaves Goby's default, 0.0.0.0 (the default interface)
 
 # The topside's default plan (sim seconds after the USV is under helm command): polygon, then waypoints.
 DEFAULT_SCHEDULE = "0:polygon:6:200,400:waypoints"
