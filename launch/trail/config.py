@@ -30,7 +30,6 @@ from launch.config import (
 )
 from launch.errors import MissionConfigError
 from launch.trail.settings import (
-    LINK_LISTEN_ADDRESS,
     MULTICAST_ADDRESS,
     REPO_ROOT,
     SUBNET_MASK,
@@ -113,7 +112,7 @@ def link_block(settings: TrailSettings, vehicle: Vehicle, link: str) -> str:
     driver {{
       driver_type: DRIVER_UDP_MULTICAST
       [goby.acomms.udp_multicast.protobuf.config] {{
-        listen_address: "{LINK_LISTEN_ADDRESS}"  # loopback: no datagram leaves this machine (docs/launch.md)
+        listen_address: "{settings.link_address}"  # TRAIL_LINK_ADDRESS (docs/launch.md)
         multicast_address: "{MULTICAST_ADDRESS}"
         multicast_port: {port}
         max_frame_size: 1400

@@ -9,6 +9,7 @@ bytes the slots could carry in the same time (each sender's slots times their ``
 
 from __future__ import annotations
 
+import ipaddress
 import logging
 import socket
 import time
@@ -20,7 +21,6 @@ from google.protobuf.message import DecodeError
 from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
 from gateway.goby.acomms.udp_multicast import join_multicast
 from launch.trail.settings import (
-    LINK_LISTEN_ADDRESS,
     MULTICAST_ADDRESS,
     TrailSettings,
     acomms_mac_slots,
@@ -71,7 +71,7 @@ class LinkMonitor:
         self.started = time.monotonic()
         for name, port in (("satellite", settings.satellite_port), ("acomms", settings.acomms_port)):
             try:
-                self._sockets[name] = _listen(MULTICAST_ADDRESS, port)
+                self._sockets[name] = _listen(MULTICAST_ADDRESS, port, settings.link_address)
             except OSError as exc:
                 self.error = f"cannot listen on {MULTICAST_ADDRESS}:{port} ({name}): {exc}"
                 log.warning("%s; link statistics will be missing", self.error)
@@ -117,8 +117,10 @@ def _count(stats: LinkStats, datagram: bytes) -> None:
     stats.bytes_by_src[msg.src] += size
 
 
-def _listen(group: str, port: int) -> socket.socket:
-    """A non-blocking UDP socket joined to ``group:port`` (as the modem driver's, without sending)."""
-    sock = join_multicast(group, port, interface=LINK_LISTEN_ADDRESS)
+def _listen(group: str, port: int, link_address: str) -> socket.socket:
+    """A non-blocking UDP socket joined to ``group:port`` where the modem drivers send (loopback or the default
+    interface, as ``listen_address`` makes the driver choose), without sending."""
+    interface = "127.0.0.1" if ipaddress.ip_address(link_address).is_loopback else "0.0.0.0"
+    sock = join_multicast(group, port, interface=interface)
     sock.setblocking(False)
     return sock

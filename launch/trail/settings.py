@@ -14,6 +14,7 @@ modem id+1+256 under subnet mask 0xFF00; acomms TDMA slots alternating USV (258)
 
 from __future__ import annotations
 
+import ipaddress
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -40,14 +41,14 @@ TOPSIDE_VEHICLE_ID = 0
 SATELLITE_SLOT = (5, 64)  # slot_seconds, max_frame_bytes (post-homework2 onward)
 ACOMMS_SLOT = (10, 128)
 MULTICAST_ADDRESS = "239.142.0.2"
-LINK_LISTEN_ADDRESS = "127.0.0.1"  # the course leaves Goby's default, 0.0.0.0 (the default interface)
 
 # The topside's default plan (sim seconds after the USV is under helm command): polygon, then waypoints.
 DEFAULT_SCHEDULE = "0:polygon:6:200,400:waypoints"
 
 _ENV = env_variables("TRAIL_", (
     "run_dir", "warp", "lat_origin", "lon_origin", "moos_port_base", "sim_port_base", "liaison_port_base",
-    "satellite_port", "acomms_port", "moosdb", "helm", "usv_helm", "liaison_address", "schedule", "socket_dir",
+    "satellite_port", "acomms_port", "moosdb", "helm", "usv_helm", "liaison_address", "link_address", "schedule",
+    "socket_dir",
     "east_duration", "south_duration"))
 
 
@@ -70,6 +71,9 @@ class TrailSettings(EnvSettings):
     helm: str = "ivp-helm"  # or pHelmIvP (the MOOS helm of every vehicle that runs one)
     usv_helm: str = "ivp"  # ivp: the MOOS helm with usv.bhv; goby: homework 3's goby-helm-example
     liaison_address: str = "127.0.0.1"  # the course binds 0.0.0.0; the page has no login, so loopback unless asked
+    # the links' listen_address: loopback keeps every datagram on this machine; the course leaves Goby's default
+    # 0.0.0.0 (the default interface), which a real gobyd in the mission needs (docs/intervehicle.md)
+    link_address: str = "127.0.0.1"
     schedule: str = DEFAULT_SCHEDULE
     socket_dir: Path = Path("")  # where the brokers' IPC sockets go (default: run_dir); AF_UNIX paths are short
     east_duration: int = 500  # homework helm legs (goby3_course_helm.pb.cfg.in)
@@ -79,6 +83,10 @@ class TrailSettings(EnvSettings):
         check_warp_and_origin(self.warp, self.lat_origin, self.lon_origin)
         if self.usv_helm not in ("ivp", "goby"):
             raise MissionConfigError(f"TRAIL_USV_HELM must be ivp or goby, not {self.usv_helm!r}")
+        try:
+            ipaddress.IPv4Address(self.link_address)
+        except ValueError:
+            raise MissionConfigError(f"TRAIL_LINK_ADDRESS must be an IPv4 address, not {self.link_address!r}") from None
         for name in ("moos_port_base", "sim_port_base", "liaison_port_base", "satellite_port", "acomms_port"):
             port = getattr(self, name)
             if not 0 < port < 65536 - 256:

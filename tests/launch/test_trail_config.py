@@ -95,6 +95,12 @@ def test_gobyd_carries_the_links_of_its_platform(settings):
     assert topside.count("slot {") == 2 and "slot_seconds: 5 max_frame_bytes: 64" in topside
     assert auv.count("slot {") == 2 * N and "slot { src: 258 slot_seconds: 10 max_frame_bytes: 128 }" in auv
     assert ("\n# intervehicle {" in usv) != broker_hosts_intervehicle()
+    # loopback unless asked: no datagram leaves the machine; TRAIL_LINK_ADDRESS=0.0.0.0 is Goby's default interface
+    assert usv.count('listen_address: "127.0.0.1"') == 2
+    wide = generate("usv", "gobyd", settings.replace(link_address="0.0.0.0"), Vehicle("usv", N))
+    assert wide.count('listen_address: "0.0.0.0"') == 2
+    with pytest.raises(MissionConfigError, match="TRAIL_LINK_ADDRESS must be an IPv4 address"):
+        settings.replace(link_address="eth0")
 
 
 def test_manager_blocks_name_the_peer_modems(settings):
