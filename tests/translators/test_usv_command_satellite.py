@@ -37,6 +37,11 @@ def test_usv_command_over_the_satellite_link(tmp_path):
                 acks = usv.collect(usv_groups.usv_command_ack, USVCommandAck)
                 assert usv.wait_subscribed()
                 wait_showing_logs(lambda: "waiting for USV commands" in manager.output(), 30, "usv-manager to start", manager)
+                # the manager's subscription crosses the link in the USV's slot; before it arrives the topside has
+                # no subscriber and a command expires at once (EXPIRED_NO_SUBSCRIBERS), as in Goby
+                topside_log = brokers["topside"].log_path
+                wait_showing_logs(lambda: "modem 2 subscribed to DCCL id" in topside_log.read_text(), 30,
+                                  "the manager's subscription at the topside", manager)
                 tool_cfg = tmp_path / "tool.pb.cfg"
                 tool_cfg.write_text(SIM + "intervehicle: true\n")
                 result = run_cli(["polygon", "--sides", "5", "--radius", "250", "--timeout", "20", str(tool_cfg)],

@@ -71,13 +71,14 @@ def link_brokers(workdir: Path, links: Mapping[str, Sequence[str]], prefix: str,
                  startup_timeout: float = 30.0) -> Iterator[dict[str, BrokerProcess]]:
     """One goby-broker process per name (platform ``<prefix>_<name>``), each hosting its ``link {}`` blocks, with
     ``header`` (an ``app {}`` block) and ``broker_config(links, warp)`` as its config file
-    (``workdir/gobyd_<name>.pb.cfg``, log ``workdir/gobyd_<name>.log``); all are stopped on leaving."""
+    (``workdir/gobyd_<name>.pb.cfg``, log ``workdir/gobyd_<name>.log`` at ``-v``: it names every subscription
+    that crossed a link); all are stopped on leaving."""
     brokers: dict[str, BrokerProcess] = {}
     try:
         for name, blocks in links.items():
             cfg = workdir / f"gobyd_{name}.pb.cfg"
             cfg.write_text(header + broker_config(blocks, warp=warp))
-            brokers[name] = BrokerProcess(workdir, platform=f"{prefix}_{name}", extra_args=[str(cfg)],
+            brokers[name] = BrokerProcess(workdir, platform=f"{prefix}_{name}", extra_args=[str(cfg), "-v"],
                                           log_path=workdir / f"gobyd_{name}.log", startup_timeout=startup_timeout)
             brokers[name].start()
         yield brokers
