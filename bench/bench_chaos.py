@@ -46,6 +46,7 @@ from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConf
 from gateway.moos import comms
 from gateway.moos.clock import MoosClock
 from launch.apps.goby_launch import RESPAWN_VAR
+from launch.process_group import ProcessGroup
 from launch.trail.mission import TrailMission, with_free_ports
 from launch.trail.settings import TrailSettings, Vehicle
 from launch.usv.mission import UsvMission
@@ -222,7 +223,21 @@ class Kill:
     recovered_at: float | None = None
 
 
-class UsvTarget:
+class _MissionTarget:
+    """What the soak needs of a mission: start it until every vehicle is under command, stop it."""
+
+    mission: UsvMission | TrailMission
+    command_timeout_s: float = 180.0
+
+    def start(self) -> None:
+        self.mission.start()
+        self.mission.wait_for_command(self.command_timeout_s)
+
+    def stop(self) -> None:
+        self.mission.stop()
+
+
+class UsvTarget(_MissionTarget):
     """The USV mission as one flat process group: the soak kills a process and restarts it itself."""
 
     def __init__(self, args: argparse.Namespace, out: Path, socket_dir: Path) -> None:
@@ -233,17 +248,10 @@ class UsvTarget:
         self.probe_moos_port, self.probe_platform = self.settings.moos_port, self.settings.platform
         self.probe_ipc_base = self.settings.ipc_base
 
-    def start(self) -> None:
-        self.mission.start()
-        self.mission.wait_for_command(180)
-
-    def stop(self) -> None:
-        self.mission.stop()
-
     def poll(self) -> None:
         self.mission.moos.poll()  # type: ignore[union-attr]
 
-    def _group(self):  # noqa: ANN202
+    def _group(self) -> ProcessGroup:
         assert self.mission.group is not None
         return self.mission.group
 
@@ -270,8 +278,10 @@ class UsvTarget:
 _LAUNCHED = re.compile(r"^Launched \((\d+)\) (\S+):", re.M)
 
 
-class TrailTarget:
+class TrailTarget(_MissionTarget):
     """The trail mission as all.launch runs it; every platform's goby-launch restarts what the soak kills."""
+
+    command_timeout_s = 300.0
 
     def __init__(self, args: argparse.Namespace, out: Path, socket_dir: Path) -> None:
         base = TrailSettings(run_dir=out, warp=args.warp, socket_dir=socket_dir, schedule="none")
@@ -283,13 +293,6 @@ class TrailTarget:
         self.probe_ipc_base = usv.ipc_base(self.settings)
         self._killed: tuple[str, int, float] = ("", 0, 0.0)  # name, pid, sim time of the last kill
         self._seen: dict[int, float] = {}  # when each new pid was first seen
-
-    def start(self) -> None:
-        self.mission.start()
-        self.mission.wait_for_command(300)
-
-    def stop(self) -> None:
-        self.mission.stop()
 
     def poll(self) -> None:
         self.mission.poll()

@@ -108,7 +108,8 @@ def test_demo_names_a_component_that_dies_and_exits_non_zero(tmp_path):
     proc = ChildProcess(
         [sys.executable, "-m", "launch.usv.demo", "--out", str(tmp_path / "o"), "--duration", "0", "--warp", "20",
          "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_port()),
-         "--sim-port", str(free_port()), "--liaison-port", str(free_port())],
+         "--sim-port", str(free_port()), "--liaison-port", str(free_port()),
+         "--topside-liaison-port", str(free_port())],
         tmp_path / "run.out",
     ).start()
     try:
