@@ -47,7 +47,7 @@ def real_moos_skip_reason(*binaries: str) -> str | None:
     return None
 
 
-COURSE_IVP_RELEASE = "19.8"  # the MOOS-IvP release ivp-helm follows (the Goby3 course's)
+COURSE_IVP_RELEASE = "19.8.1"  # the MOOS-IvP release ivp-helm follows (the Goby3 course's)
 
 
 def ivp_release(binary: str = "pHelmIvP") -> str | None:

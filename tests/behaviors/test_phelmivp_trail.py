@@ -98,8 +98,8 @@ def test_auv_file_trails_and_recovers_alike_under_both_helms(tmp_path: Path) -> 
     release = ivp_release()
     for helm, result in results.items():
         errors = result["errors"]
-        # BHV_Trail's geometry changed after the course's release (24.8 holds a steady ~18 deg bearing offset):
-        # the bearing bound applies to ivp-helm and to pHelmIvP of the course's release
+        # BHV_Trail's geometry changed after the course's release (24.8 holds a steady ~18 deg bearing offset and
+        # trails outside the point): the bearing bound applies to ivp-helm and to pHelmIvP of the course's release
         bearing_bound = 15 if helm == "ivp-helm" or release == COURSE_IVP_RELEASE else 180
         good = sum(abs(dr) <= 10 and abs(db) <= bearing_bound for dr, db in errors)
         mean_range = sum(dr for dr, _ in errors) / len(errors)
@@ -116,7 +116,8 @@ def test_auv_file_trails_and_recovers_alike_under_both_helms(tmp_path: Path) -> 
         assert "BehaviorError" in allstops and allstops[allstops.index("BehaviorError") + 1:] == ["clear"], helm
     assert results["pHelmIvP"]["bhv_error"] == results["ivp-helm"]["bhv_error"] == [
         "trail_usv: USV x/y/heading/speed info not found"]
-    assert abs(results["pHelmIvP"]["mean_range"] - results["ivp-helm"]["mean_range"]) <= 3.0
+    if release == COURSE_IVP_RELEASE:  # the same geometry: the same side of the trail point within 3 m
+        assert abs(results["pHelmIvP"]["mean_range"] - results["ivp-helm"]["mean_range"]) <= 3.0
 
 
 REPORTER_MOOS = """\
