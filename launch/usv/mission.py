@@ -91,15 +91,29 @@ class UsvMission:
         # is read while the launch waits between processes, so start-up events get their real times.
         self.moos = MoosRecorder(self.record, self.clock, self.settings.moos_port)
         self.moos.start()
-        self.group.on_wait = self.moos.poll
+        self.group.on_wait = self._record_start_up
         self.group.start()
         self._wait_for_brokers()
-        self.portal = PortalRecorder(self.record, self.clock, self.settings.platform, self.settings.ipc_base)
-        self.portal.start()
-        # the shore's broker: the satellite link's acks of the commands (slot wait, ack time)
-        self.topside = PortalRecorder(self.record, self.clock, self.settings.topside_platform,
-                                      self.settings.topside_ipc_base)
-        self.topside.start()
+        self._start_portal_recorders()
+
+    def _record_start_up(self) -> None:
+        """While the launch waits between processes: read MOOS mail, and start each portal recorder as soon as its
+        broker is up, so it listens before the shore (launched after both brokers) can send anything."""
+        assert self.moos is not None
+        self.moos.poll()
+        self._start_portal_recorders(only_ready=True)
+
+    def _start_portal_recorders(self, only_ready: bool = False) -> None:
+        """The USV broker's recorder (interface state) and the topside's (the satellite link's acks)."""
+        ready = {base: Path(base + ".manager").exists() or not only_ready
+                 for base in (self.settings.ipc_base, self.settings.topside_ipc_base)}
+        if self.portal is None and ready[self.settings.ipc_base]:
+            self.portal = PortalRecorder(self.record, self.clock, self.settings.platform, self.settings.ipc_base)
+            self.portal.start()
+        if self.topside is None and ready[self.settings.topside_ipc_base]:
+            self.topside = PortalRecorder(self.record, self.clock, self.settings.topside_platform,
+                                          self.settings.topside_ipc_base)
+            self.topside.start()
 
     def _wait_for_brokers(self, timeout_s: float = 120.0) -> None:
         """Block until both brokers (the USV's, the topside's) have their manager socket: the topside's is launched
