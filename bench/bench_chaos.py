@@ -30,7 +30,6 @@ import contextlib
 import logging
 import os
 import random
-import re
 import signal
 import statistics
 import sys
@@ -46,14 +45,14 @@ from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConf
 from gateway.moos import comms
 from gateway.moos.clock import MoosClock
 from launch.apps.goby_launch import RESPAWN_VAR
-from launch.process_group import ProcessGroup
+from launch.process_group import LAUNCHED_LINE, ProcessGroup
 from launch.trail.mission import TrailMission, with_free_ports
 from launch.trail.settings import TrailSettings, Vehicle
 from launch.usv.mission import UsvMission
 from launch.usv.settings import UsvSettings
 from util.cli import bounded_number
 from util.logsetup import add_verbosity_argument, configure_logging
-from util.process import free_port, handle_signals
+from util.process import free_port, handle_signals, pid_alive
 
 log = logging.getLogger(__name__)
 
@@ -275,9 +274,6 @@ class UsvTarget(_MissionTarget):
         return time.monotonic() - process.started_at >= 1.0
 
 
-_LAUNCHED = re.compile(r"^Launched \((\d+)\) (\S+):", re.M)
-
-
 class TrailTarget(_MissionTarget):
     """The trail mission as all.launch runs it; every platform's goby-launch restarts what the soak kills."""
 
@@ -291,7 +287,7 @@ class TrailTarget(_MissionTarget):
         usv = Vehicle("usv", args.auvs)
         self.probe_moos_port, self.probe_platform = usv.moos_port(self.settings), usv.name
         self.probe_ipc_base = usv.ipc_base(self.settings)
-        self._killed: tuple[str, int, float] = ("", 0, 0.0)  # name, pid, sim time of the last kill
+        self._killed_pid, self._killed_sim_t = 0, 0.0  # the last kill's victim and the sim time it died
         self._seen: dict[int, float] = {}  # when each new pid was first seen
 
     def poll(self) -> None:
@@ -302,38 +298,31 @@ class TrailTarget(_MissionTarget):
         assert self.mission.group is not None
         found: dict[str, int] = {}
         for launcher in self.mission.group.processes:
-            for pid, name in _LAUNCHED.findall(launcher.child.output()):
+            for pid, name in LAUNCHED_LINE.findall(launcher.child.output()):
                 found[name] = int(pid)  # the newest launch of each name wins
-        return {name: pid for name, pid in found.items() if _alive(pid)}
+        return {name: pid for name, pid in found.items() if pid_alive(pid)}
 
     def kill(self, name: str) -> None:
-        self._killed = (name, self.processes()[name], self.mission.clock.now())
+        self._killed_pid, self._killed_sim_t = self.processes()[name], self.mission.clock.now()
         self._seen.clear()
         with contextlib.suppress(ProcessLookupError):
-            os.kill(self._killed[1], signal.SIGKILL)
+            os.kill(self._killed_pid, signal.SIGKILL)
 
     def nav_since(self, kill: Kill, last_nav: float) -> bool:
         """Every vehicle with a MOOSDB has had a NAV fix since the kill (the USV's is also the probe's)."""
         for run in self.mission.runs.values():
             nav, _ = run.record.snapshot()
-            if run.moos is not None and (not nav or nav[-1].t <= self._killed[2]):
+            if run.moos is not None and (not nav or nav[-1].t <= self._killed_sim_t):
                 return False
         return last_nav > kill.at
 
     def back(self, name: str, kill: Kill) -> bool:
         """Its launcher has started it again (a new pid under the same name) and it has been up 1 s."""
         pid = self.processes().get(name)
-        if pid is None or pid == self._killed[1]:
+        if pid is None or pid == self._killed_pid:
             return False
         first_seen = self._seen.setdefault(pid, time.monotonic())
         return time.monotonic() - first_seen >= 1.0
-
-
-def _alive(pid: int) -> bool:
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return False
 
 
 def _wait_recovered(target: UsvTarget | TrailTarget, probes: tuple[MoosProbe, PortalProbe], kill: Kill) -> None:

@@ -27,6 +27,8 @@ log = logging.getLogger(__name__)
 Reporter = Callable[[str], None]
 _ASSIGNMENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*=")
 POLL_PERIOD_S = 0.1
+# The line a launcher prints per launch (``_report_launched``): pid and name, for tools reading its output.
+LAUNCHED_LINE = re.compile(r"^Launched \((\d+)\) (\S+):", re.M)
 BROKER_PROGRAMS = frozenset({"goby-broker", "gobyd"})
 
 
@@ -151,9 +153,13 @@ class ProcessGroup:
             raise LaunchError(f"cannot start {name!r} ({entry.command}): {exc}") from exc
         process = ManagedProcess(name=name, entry=entry, child=child)
         self.processes.append(process)
-        self.report(f"Launched ({child.pid}) {name}: {entry.command}")
+        self._report_launched(process)
         log.info("launched %s pid %d, log %s", name, child.pid, child.log_path)
         return process
+
+    def _report_launched(self, process: ManagedProcess) -> None:
+        """``Launched (<pid>) <name>: <command>``, as goby_launch prints it (``LAUNCHED_LINE`` reads it back)."""
+        self.report(f"Launched ({process.pid}) {process.name}: {process.entry.command}")
 
     def start(self) -> None:
         """Launch every entry in order with the launch delay, then check that all are still up.
@@ -220,7 +226,7 @@ class ProcessGroup:
         process.reported = False
         process.started_at = time.monotonic()
         process.respawns += 1
-        self.report(f"Launched ({process.pid}) {process.name}: {process.entry.command}")
+        self._report_launched(process)
         return process
 
     def supervise(self, status_period_s: float = 5.0, respawn_limit: int = 0) -> int:

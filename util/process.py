@@ -52,6 +52,14 @@ def port_open(port: int, host: str = "127.0.0.1") -> bool:
         return sock.connect_ex((host, port)) == 0
 
 
+def pid_alive(pid: int) -> bool:
+    """True while process ``pid`` exists and is not a zombie (``/proc``; a reaped or unknown pid is not alive)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return False
+
+
 def wait_until(predicate: Callable[[], T], timeout: float = 20.0, what: str = "", *, interval: float = 0.02) -> T:
     """Poll ``predicate`` until it returns something truthy, and return that.
 

@@ -34,6 +34,7 @@ LAUNCH_DIR_VAR = "GOBY_LAUNCH_DIR"
 LOG_DIR_VAR = "GOBY_LAUNCH_LOG_DIR"
 PLATFORM_VAR = "GOBY_LAUNCH_PLATFORM"  # the platform name (-p), for name= directives
 RESPAWN_VAR = "GOBY_LAUNCH_RESPAWN"  # default of --respawn; inherited by nested launchers (not in goby_launch)
+_respawn_count = bounded_number(int, 0)  # --respawn and GOBY_LAUNCH_RESPAWN: a whole number >= 0
 _UNSUPPORTED_MODES = {
     "screen": "-s (GNU screen)",
     "nohup": "-n (nohup)",
@@ -61,7 +62,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-b", dest="background", action="store_true", help="not supported here")
     parser.add_argument("--status-period", type=float, default=5.0, help="seconds between status lines (5)")
     parser.add_argument("--startup-check", type=float, default=1.0, help="seconds to watch after the last launch (1)")
-    parser.add_argument("--respawn", type=bounded_number(int, 0), default=None, metavar="N",
+    parser.add_argument("--respawn", type=_respawn_count, default=None, metavar="N",
                         help=f"start a process that dies again, up to N times each (default ${RESPAWN_VAR} or 0: "
                         "the first death stops everything, as goby_launch does)")
     add_verbosity_argument(parser)
@@ -89,9 +90,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"goby-launch: {exc}", file=sys.stderr)
         return 1
     try:
-        respawn_limit = args.respawn if args.respawn is not None else int(os.environ.get(RESPAWN_VAR, "0"))
-    except ValueError:
-        print(f"goby-launch: {RESPAWN_VAR}={os.environ[RESPAWN_VAR]!r} is not a whole number", file=sys.stderr)
+        respawn_limit = args.respawn if args.respawn is not None else _respawn_count(os.environ.get(RESPAWN_VAR, "0"))
+    except argparse.ArgumentTypeError as exc:
+        print(f"goby-launch: {RESPAWN_VAR}: {exc}", file=sys.stderr)
         return 2
     platform = args.platform or Path(args.launchfile).stem
     log_dir = default_log_dir(platform, os.environ) if args.log_dir is None else args.log_dir

@@ -9,7 +9,6 @@ bytes the slots could carry in the same time (each sender's slots times their ``
 
 from __future__ import annotations
 
-import ipaddress
 import logging
 import socket
 import time
@@ -19,7 +18,7 @@ from dataclasses import dataclass, field
 from google.protobuf.message import DecodeError
 
 from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
-from gateway.goby.acomms.udp_multicast import join_multicast
+from gateway.goby.acomms.udp_multicast import join_multicast, multicast_interface
 from launch.trail.settings import (
     MULTICAST_ADDRESS,
     TrailSettings,
@@ -120,7 +119,6 @@ def _count(stats: LinkStats, datagram: bytes) -> None:
 def _listen(group: str, port: int, link_address: str) -> socket.socket:
     """A non-blocking UDP socket joined to ``group:port`` where the modem drivers send (loopback or the default
     interface, as ``listen_address`` makes the driver choose), without sending."""
-    interface = "127.0.0.1" if ipaddress.ip_address(link_address).is_loopback else "0.0.0.0"
-    sock = join_multicast(group, port, interface=interface)
+    sock = join_multicast(group, port, interface=multicast_interface(link_address))
     sock.setblocking(False)
     return sock

@@ -101,16 +101,15 @@ class UsvMission:
         broker is up, so it listens before the shore (launched after both brokers) can send anything."""
         assert self.moos is not None
         self.moos.poll()
-        self._start_portal_recorders(only_ready=True)
+        self._start_portal_recorders()
 
-    def _start_portal_recorders(self, only_ready: bool = False) -> None:
-        """The USV broker's recorder (interface state) and the topside's (the satellite link's acks)."""
-        ready = {base: Path(base + ".manager").exists() or not only_ready
-                 for base in (self.settings.ipc_base, self.settings.topside_ipc_base)}
-        if self.portal is None and ready[self.settings.ipc_base]:
+    def _start_portal_recorders(self) -> None:
+        """The USV broker's recorder (interface state) and the topside's (the satellite link's acks), each once its
+        broker's manager socket exists."""
+        if self.portal is None and Path(self.settings.ipc_base + ".manager").exists():
             self.portal = PortalRecorder(self.record, self.clock, self.settings.platform, self.settings.ipc_base)
             self.portal.start()
-        if self.topside is None and ready[self.settings.topside_ipc_base]:
+        if self.topside is None and Path(self.settings.topside_ipc_base + ".manager").exists():
             self.topside = PortalRecorder(self.record, self.clock, self.settings.topside_platform,
                                           self.settings.topside_ipc_base)
             self.topside.start()

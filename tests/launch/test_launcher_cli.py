@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from util.process import ChildProcess, wait_until
+from launch.process_group import LAUNCHED_LINE
+from util.process import ChildProcess, pid_alive, wait_until
 
 # A child that records the signal it got in its log, so the test can see the shutdown order.
 CHILD = textwrap.dedent(
@@ -46,20 +47,8 @@ def finish(run: ChildProcess, timeout: float = 60.0) -> str:
     return run.output()
 
 
-def _pid_alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    stat = Path(f"/proc/{pid}/stat")
-    try:
-        return stat.read_text().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return False
-
-
 def _launched_pids(output: str) -> list[int]:
-    return [int(p) for p in re.findall(r"^Launched \((\d+)\)", output, flags=re.M)]
+    return [int(pid) for pid, _ in LAUNCHED_LINE.findall(output)]
 
 
 @pytest.fixture
@@ -96,7 +85,7 @@ def test_starts_in_order_and_stops_in_reverse_on_sigint(tmp_path, child_script):
         assert match, f"{name} did not get {sig}"
         stamps[name] = float(match.group(1))
     assert stamps["third"] < stamps["second"] < stamps["first"], stamps
-    assert all(not _pid_alive(pid) for pid in _launched_pids(output))
+    assert all(not pid_alive(pid) for pid in _launched_pids(output))
 
 
 def test_a_dying_process_is_named_with_its_log_tail_and_the_rest_are_stopped(tmp_path, child_script):
@@ -112,7 +101,7 @@ def test_a_dying_process_is_named_with_its_log_tail_and_the_rest_are_stopped(tmp
     assert "doomed died unexpectedly (exit status 3)" in output
     assert "boom: cannot reach the MOOSDB" in output
     assert "survivor got SIGTERM" in (logs / "survivor.log").read_text()
-    assert all(not _pid_alive(pid) for pid in _launched_pids(output))
+    assert all(not pid_alive(pid) for pid in _launched_pids(output))
 
 
 def test_death_during_startup_fails_the_launch(tmp_path, child_script):
@@ -126,7 +115,7 @@ def test_death_during_startup_fails_the_launch(tmp_path, child_script):
     assert run.returncode == 1
     assert "failed to launch" in output and "'missing'" in output
     assert "no-such-program-xyz" in output  # bash's "not found" from the log tail
-    assert all(not _pid_alive(pid) for pid in _launched_pids(output))
+    assert all(not pid_alive(pid) for pid in _launched_pids(output))
 
 
 def test_sigkill_after_the_kill_timeout(tmp_path):
@@ -216,14 +205,14 @@ def test_respawn_flag_restarts_a_killed_process_up_to_its_limit(tmp_path, child_
         again = _launched_pids(run.output())[2]
         wait_until(lambda: _read(logs / "victim.log").count("victim up") == 2, 30, "the second victim up")
         assert "respawning it (1 of 1)" in run.output()
-        assert _pid_alive(steady) and run.running
+        assert pid_alive(steady) and run.running
         os.kill(again, signal.SIGKILL)  # the second death is past the limit: everything stops, exit 1
         output = finish(run)
     finally:
         run.stop()
     assert run.returncode == 1, output
     assert "victim died unexpectedly (exit status -9); stopping the others" in output
-    assert not _pid_alive(steady)
+    assert not pid_alive(steady)
 
 
 def test_respawn_comes_from_the_environment_for_nested_launchers(tmp_path, child_script):
@@ -248,6 +237,9 @@ def test_respawn_refuses_a_bad_count(tmp_path):
     result = subprocess.run([sys.executable, "-m", "launch.apps.goby_launch", "--respawn", "-1", str(launch_file)],
                             capture_output=True, text=True, timeout=60)
     assert result.returncode == 2 and "--respawn" in result.stderr
+    result = subprocess.run([sys.executable, "-m", "launch.apps.goby_launch", str(launch_file)], capture_output=True,
+                            text=True, timeout=60, env=os.environ | {"GOBY_LAUNCH_RESPAWN": "-1"})
+    assert result.returncode == 2 and "GOBY_LAUNCH_RESPAWN: '-1' is not a finite number" in result.stderr
 
 
 def _read(path: Path) -> str:

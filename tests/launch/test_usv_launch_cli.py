@@ -16,10 +16,10 @@ from pathlib import Path
 import pytest
 
 from gateway.goby.intervehicle.testing import random_multicast
-from launch.process_group import child_environment
+from launch.process_group import LAUNCHED_LINE, child_environment
 from launch.usv.mission import LAUNCH_FILE
 from launch.usv.settings import UsvSettings
-from util.process import ChildProcess, free_port, wait_until
+from util.process import ChildProcess, free_port, pid_alive, wait_until
 
 
 def expect(run: ChildProcess, pattern: str, timeout: float = 90.0) -> re.Match[str]:
@@ -34,14 +34,6 @@ def finish(run: ChildProcess, timeout: float = 90.0) -> str:
     run.wait(timeout)
     run.stop()
     return run.output()
-
-
-def _alive(pid: int) -> bool:
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except OSError:
-        return False
-    return state != "Z"
 
 
 def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_path):
@@ -68,9 +60,9 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
         shutil.rmtree(socket_dir, ignore_errors=True)
     assert proc.returncode == 1, text
     assert "usv.helm died unexpectedly (exit status -9)" in text
-    pids = [int(p) for p in re.findall(r"^Launched \((\d+)\)", text, flags=re.M)]
+    pids = [int(pid) for pid, _ in LAUNCHED_LINE.findall(text)]
     assert len(pids) == 11
-    assert not any(_alive(pid) for pid in pids), text
+    assert not any(pid_alive(pid) for pid in pids), text
     logs = sorted(p.name for p in (tmp_path / "logs").iterdir())
     assert "usv.frontseat-interface.log" in logs and "usv.shore.log" in logs
     assert "MOOSDB usv listening" in (tmp_path / "logs" / "usv.moosdb.log").read_text()

@@ -46,6 +46,11 @@ def join_multicast(group: str, port: int, interface: str = "0.0.0.0", bind_addre
     return sock
 
 
+def multicast_interface(listen_address: str) -> str:
+    """The interface a node joins and sends on: loopback for a loopback ``listen_address``, else the default one."""
+    return "127.0.0.1" if ipaddress.ip_address(listen_address).is_loopback else "0.0.0.0"
+
+
 def multicast_config(cfg: DriverConfig) -> udp_pb.Config:
     """The driver's ``[goby.acomms.udp_multicast.protobuf.config]`` block (defaults if absent)."""
     return cfg.Extensions[udp_pb.config]
@@ -69,8 +74,8 @@ class UDPMulticastDriver(DatagramDriver):
                 raise ModemDriverError(f"udp_multicast.multicast_address {group!r} is not a multicast address")
         except ValueError as exc:
             raise ModemDriverError(f"udp_multicast.multicast_address {group!r}: {exc}") from None
-        loopback = ipaddress.ip_address(self._mc.listen_address).is_loopback
-        interface = "127.0.0.1" if loopback else "0.0.0.0"
+        interface = multicast_interface(self._mc.listen_address)
+        loopback = interface != "0.0.0.0"
         try:
             # Bind the wildcard address: on Linux a socket bound to 127.0.0.1 does not receive multicast.
             sock = join_multicast(group, port, interface, "0.0.0.0" if loopback else self._mc.listen_address)
