@@ -36,6 +36,17 @@ def finish(run: ChildProcess, timeout: float = 90.0) -> str:
     return run.output()
 
 
+def start_demo(tmp_path: Path, out_dir: Path, *args: str) -> ChildProcess:
+    """``python -m launch.usv.demo`` at warp 20 with our MOOSDB and helm, every port free, output in ``run.out``."""
+    return ChildProcess(
+        [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--warp", "20", *args,
+         "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_port()),
+         "--sim-port", str(free_port()), "--liaison-port", str(free_port()),
+         "--topside-liaison-port", str(free_port())],
+        tmp_path / "run.out",
+    ).start()
+
+
 def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_path):
     socket_dir = Path(tempfile.mkdtemp(prefix="usvl-", dir="/tmp"))
     settings = UsvSettings(run_dir=tmp_path / "run", warp=10, moos_port=free_port(), sim_port=free_port(),
@@ -70,13 +81,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
 
 def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(tmp_path):
     out_dir = tmp_path / "o"
-    proc = ChildProcess(
-        [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--forever", "--warp", "20",
-         "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_port()),
-         "--sim-port", str(free_port()), "--liaison-port", str(free_port()),
-         "--topside-liaison-port", str(free_port())],
-        tmp_path / "run.out",
-    ).start()
+    proc = start_demo(tmp_path, out_dir, "--forever")
     try:
         expect(proc, r"^t=\s*(1\d\d|[2-9]\d\d) s sim \| interface INTERFACE_COMMAND \| helm DRIVE")
         proc.send_signal(signal.SIGINT)
@@ -97,13 +102,7 @@ def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(
 
 
 def test_demo_names_a_component_that_dies_and_exits_non_zero(tmp_path):
-    proc = ChildProcess(
-        [sys.executable, "-m", "launch.usv.demo", "--out", str(tmp_path / "o"), "--duration", "0", "--warp", "20",
-         "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_port()),
-         "--sim-port", str(free_port()), "--liaison-port", str(free_port()),
-         "--topside-liaison-port", str(free_port())],
-        tmp_path / "run.out",
-    ).start()
+    proc = start_demo(tmp_path, tmp_path / "o", "--duration", "0")
     try:
         sim_pid = int(expect(proc, r"^Launched \((\d+)\) usv\.frontseat-sim:").group(1))
         expect(proc, r"^t=\s*\d+/?\S* s sim \| interface INTERFACE_COMMAND")
@@ -145,13 +144,7 @@ def test_demo_refuses_bad_arguments_before_starting_anything(tmp_path, args, mes
 
 def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(tmp_path):
     out_dir = tmp_path / "o"
-    proc = ChildProcess(
-        [sys.executable, "-m", "launch.usv.demo", "--out", str(out_dir), "--forever", "--warp", "20",
-         "--schedule", "none", "--moosdb", "ours", "--helm", "ours", "--moos-port", str(free_port()),
-         "--sim-port", str(free_port()), "--liaison-port", str(free_port()),
-         "--topside-liaison-port", str(free_port())],
-        tmp_path / "run.out",
-    ).start()
+    proc = start_demo(tmp_path, out_dir, "--forever", "--schedule", "none")
     sent: subprocess.CompletedProcess[str] | None = None
     try:
         commander = expect(proc, r"Command it from the browser: (http://127\.0\.0\.1:\d+/\?_=/commander) \(over the "
