@@ -24,7 +24,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from google.protobuf import text_format
 
@@ -69,6 +69,11 @@ class ScheduledCommand:
 
 
 NO_SCHEDULE = "none"
+#: For this long after the plan clock starts (sim s), a command the satellite link expires for want of a subscriber
+#: is sent again every ``RESEND_S``: at a high warp the vehicle reaches COMMAND before its intervehicle subscription
+#: has crossed the link, and Goby expires a publication with no known subscriber at once (EXPIRED_NO_SUBSCRIBERS).
+NO_SUBSCRIBER_RETRY_S = 120.0
+RESEND_S = 5.0
 SCHEDULE_HELP = f"T:waypoints / T:polygon:SIDES:RADIUS, comma-separated, T in sim seconds; {NO_SCHEDULE} for no commands"
 
 
@@ -197,7 +202,15 @@ class ShoreOperator(SingleThreadApplication):
         command = self._sent.get(ack.command_time) if ack.HasField("command_time") else None
         if command is None:
             return
-        print(f"shore: t={self._sim_elapsed():.0f} s {command.describe()}: {describe_ack(ack)}", flush=True)
+        now = self._sim_elapsed()
+        if (ack.stage == USVCommandAck.LINK_EXPIRED and ack.error == "EXPIRED_NO_SUBSCRIBERS"
+                and now < NO_SUBSCRIBER_RETRY_S):
+            again = replace(command, at=now + RESEND_S)
+            self._plan.insert(next((i for i, c in enumerate(self._plan) if c.at > again.at), len(self._plan)), again)
+            print(f"shore: t={now:.0f} s {command.describe()}: no subscriber on the satellite link yet (the USV's "
+                  f"subscription has not crossed it); sending again at t={again.at:.0f} s", flush=True)
+            return
+        print(f"shore: t={now:.0f} s {command.describe()}: {describe_ack(ack)}", flush=True)
         if ack.stage in (USVCommandAck.REFUSED, USVCommandAck.LINK_EXPIRED):
             log.error("command %s not carried out: %s", command.describe(), describe_ack(ack))
 

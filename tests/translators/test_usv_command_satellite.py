@@ -8,6 +8,8 @@ import sys
 
 from translator_procs import run_cli, start_child, wait_showing_logs
 
+from frontseat import groups as frontseat_groups
+from frontseat.protobuf.frontseat_pb2 import INTERFACE_COMMAND, InterfaceStatus
 from gateway.goby.intervehicle.testing import LoopbackLink, link_brokers
 from gateway.goby.portal.testing import PortalClient
 from tests.markers import needs_loopback_multicast
@@ -54,3 +56,47 @@ def test_usv_command_over_the_satellite_link(tmp_path):
                 manager.stop()
     assert [(c.polygon_sides, c.polygon_radius) for c in commands] == [(5, 250)]  # checked, then republished once
     assert [a.stage for a in acks] == [USVCommandAck.RECEIVED_BY_MANAGER]
+
+
+def test_shore_sends_again_a_command_the_link_expired_before_the_usv_subscribed(tmp_path):
+    """The mission's scripted shore: at a high warp the USV reaches COMMAND before usv-manager's subscription has
+    crossed the link, so the first command is expired at once (EXPIRED_NO_SUBSCRIBERS, as Goby does); the shore
+    sends it again until the subscription has arrived, then the USV acks it."""
+    warp = 10  # the resend window is 120 sim s: 12 s here, room for usv-manager to start on a loaded machine
+    sim = SIM.replace(f"warp_factor: {WARP}", f"warp_factor: {warp}")
+    sat = LoopbackLink(SAT)
+    children = []
+    with link_brokers(tmp_path, {"topside": [sat.block(1)], "usv": [sat.block(2)]}, "shore", header=sim) as brokers:
+        try:
+            shore_cfg = tmp_path / "shore.pb.cfg"
+            shore_cfg.write_text(sim + "intervehicle: true\n")
+            shore = start_child("shore", [
+                sys.executable, "-m", "launch.usv.shore", str(shore_cfg), "--schedule", "0:polygon:5:250",
+                "--vehicle-interprocess", brokers["usv"].interprocess_text()], tmp_path, brokers["topside"].env())
+            children.append(shore)
+            with PortalClient(brokers["usv"].interprocess_config(), name="usv_probe") as usv:
+                commands = usv.collect(usv_groups.usv_command, USVCommand)
+                assert usv.wait_subscribed()
+
+                def vehicle_under_command() -> bool:
+                    usv.publish(frontseat_groups.status, InterfaceStatus(state=INTERFACE_COMMAND))
+                    usv.poll(0.05)
+                    return "plan clock started" in shore.output()
+
+                wait_showing_logs(vehicle_under_command, 30, "the shore to see COMMAND", shore)
+                wait_showing_logs(lambda: "no subscriber on the satellite link yet" in shore.output(), 30,
+                                  "the first command expired for want of a subscriber", shore)
+                manager_cfg = tmp_path / "manager.pb.cfg"
+                manager_cfg.write_text(sim)
+                children.append(start_child("usv_manager", [sys.executable, "-m", "translators.apps.usv_manager",
+                                                           str(manager_cfg), "-v"], tmp_path, brokers["usv"].env()))
+                wait_showing_logs(lambda: "acked over the satellite link by satellite modem 2" in shore.output(), 30,
+                                  "the command sent again and acked", *children)
+                usv.poll_until(lambda: bool(commands), 10)
+        finally:
+            for child in children:
+                child.stop()
+    text = shore.output()
+    assert "NOT delivered" not in text and "ERROR" not in text, text
+    assert text.count("sent polygon --sides 5 --radius 250") >= 2, text
+    assert [(c.polygon_sides, c.polygon_radius) for c in commands] == [(5, 250)]
