@@ -17,6 +17,7 @@ Schedule format: comma-separated ``T:waypoints`` or ``T:polygon:SIDES:RADIUS`` e
 from __future__ import annotations
 
 import argparse
+import bisect
 import logging
 import math
 import os
@@ -206,7 +207,7 @@ class ShoreOperator(SingleThreadApplication):
         if (ack.stage == USVCommandAck.LINK_EXPIRED and ack.error == "EXPIRED_NO_SUBSCRIBERS"
                 and now < NO_SUBSCRIBER_RETRY_S):
             again = replace(command, at=now + RESEND_S)
-            self._plan.insert(next((i for i, c in enumerate(self._plan) if c.at > again.at), len(self._plan)), again)
+            bisect.insort(self._plan, again, key=lambda c: c.at)
             print(f"shore: t={now:.0f} s {command.describe()}: no subscriber on the satellite link yet (the USV's "
                   f"subscription has not crossed it); sending again at t={again.at:.0f} s", flush=True)
             return
