@@ -18,6 +18,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from gateway.goby.portal.endpoints import ipc_manager_path
 from launch.apps.goby_launch import LAUNCH_DIR_VAR, LOG_DIR_VAR, PLATFORM_VAR
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import LaunchEntry, parse_file, parse_lines
@@ -163,7 +164,7 @@ class TrailMission:
     def wait_for_brokers(self, timeout_s: float = 120.0) -> None:
         """Block until every recorded vehicle's broker has its manager socket (portal clients time out otherwise)."""
         deadline = time.monotonic() + timeout_s
-        sockets = {name: Path(run.vehicle.ipc_base(self.settings) + ".manager") for name, run in self.runs.items()}
+        sockets = {name: Path(ipc_manager_path(run.vehicle.ipc_base(self.settings))) for name, run in self.runs.items()}
         while missing := [name for name, path in sockets.items() if not path.exists()]:
             if self.stop_event.is_set():
                 return

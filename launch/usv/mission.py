@@ -14,6 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from gateway.goby.portal.endpoints import ipc_manager_path
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import parse_file
 from launch.liaison.portal_side import READY_PREFIX as LIAISON_READY
@@ -94,7 +95,6 @@ class UsvMission:
         self.group.on_wait = self._record_start_up
         self.group.start()
         self._wait_for_brokers()
-        self._start_portal_recorders()
 
     def _record_start_up(self) -> None:
         """While the launch waits between processes: read MOOS mail, and start each portal recorder as soon as its
@@ -103,23 +103,31 @@ class UsvMission:
         self.moos.poll()
         self._start_portal_recorders()
 
-    def _start_portal_recorders(self) -> None:
+    def _start_portal_recorders(self) -> list[str]:
         """The USV broker's recorder (interface state) and the topside's (the satellite link's acks), each once its
-        broker's manager socket exists."""
-        if self.portal is None and Path(self.settings.ipc_base + ".manager").exists():
-            self.portal = PortalRecorder(self.record, self.clock, self.settings.platform, self.settings.ipc_base)
-            self.portal.start()
-        if self.topside is None and Path(self.settings.topside_ipc_base + ".manager").exists():
-            self.topside = PortalRecorder(self.record, self.clock, self.settings.topside_platform,
-                                          self.settings.topside_ipc_base)
-            self.topside.start()
+        broker is up; returns the manager sockets still missing."""
+        if self.portal is None:
+            self.portal = self._recorder_if_up(self.settings.platform, self.settings.ipc_base)
+        if self.topside is None:
+            self.topside = self._recorder_if_up(self.settings.topside_platform, self.settings.topside_ipc_base)
+        return [ipc_manager_path(base) for recorder, base in ((self.portal, self.settings.ipc_base),
+                                                              (self.topside, self.settings.topside_ipc_base))
+                if recorder is None]
+
+    def _recorder_if_up(self, platform: str, ipc_base: str) -> PortalRecorder | None:
+        """A started recorder on the broker at ``ipc_base``, or None while its manager socket does not exist."""
+        if not Path(ipc_manager_path(ipc_base)).exists():
+            return None
+        recorder = PortalRecorder(self.record, self.clock, platform, ipc_base)
+        recorder.start()
+        return recorder
 
     def _wait_for_brokers(self, timeout_s: float = 120.0) -> None:
-        """Block until both brokers (the USV's, the topside's) have their manager socket: the topside's is launched
-        late, and a portal client gives up if its broker does not answer."""
+        """Block until both portal recorders have started, i.e. both brokers (the USV's, the topside's) have their
+        manager socket: the topside's is launched late, and a portal client gives up if its broker does not
+        answer."""
         deadline = time.monotonic() + timeout_s
-        sockets = [Path(base + ".manager") for base in (self.settings.ipc_base, self.settings.topside_ipc_base)]
-        while missing := [str(path) for path in sockets if not path.exists()]:
+        while missing := self._start_portal_recorders():
             if self.stop_event.is_set():
                 return
             self._check()

@@ -31,6 +31,7 @@ from google.protobuf import text_format
 
 from frontseat import groups as frontseat_groups
 from frontseat.protobuf.frontseat_pb2 import INTERFACE_COMMAND, InterfaceStatus
+from gateway.goby.intervehicle import ExpireData
 from gateway.goby.portal import SimpleThread, SingleThreadApplication, run_application
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from launch.errors import MissionConfigError
@@ -74,6 +75,7 @@ NO_SCHEDULE = "none"
 #: is sent again every ``RESEND_S``: at a high warp the vehicle reaches COMMAND before its intervehicle subscription
 #: has crossed the link, and Goby expires a publication with no known subscriber at once (EXPIRED_NO_SUBSCRIBERS).
 NO_SUBSCRIBER_RETRY_S = 120.0
+NO_SUBSCRIBERS = ExpireData.ExpireReason.Name(ExpireData.EXPIRED_NO_SUBSCRIBERS)  # as SatelliteCommander reports it
 RESEND_S = 5.0
 SCHEDULE_HELP = f"T:waypoints / T:polygon:SIDES:RADIUS, comma-separated, T in sim seconds; {NO_SCHEDULE} for no commands"
 
@@ -204,7 +206,7 @@ class ShoreOperator(SingleThreadApplication):
         if command is None:
             return
         now = self._sim_elapsed()
-        if (ack.stage == USVCommandAck.LINK_EXPIRED and ack.error == "EXPIRED_NO_SUBSCRIBERS"
+        if (ack.stage == USVCommandAck.LINK_EXPIRED and ack.error == NO_SUBSCRIBERS
                 and now < NO_SUBSCRIBER_RETRY_S):
             again = replace(command, at=now + RESEND_S)
             bisect.insort(self._plan, again, key=lambda c: c.at)

@@ -21,6 +21,7 @@ from gateway.goby.portal.endpoints import (
     MANAGER_RESPONSE_GROUP,
     ip_address,
     ipc_base,
+    ipc_manager_path,
     manager_endpoint,
     tcp_endpoint,
 )
@@ -109,8 +110,8 @@ class Broker:
             raise ClosedError("broker was stopped; create a new one")
         if self._started:
             return self
-        if not self.is_tcp and _ipc_in_use(ipc_base(self.ipc) + ".manager"):
-            raise BrokerError(f"another broker already serves {ipc_base(self.ipc)}.manager "
+        if not self.is_tcp and _ipc_in_use(ipc_manager_path(ipc_base(self.ipc))):
+            raise BrokerError(f"another broker already serves {ipc_manager_path(ipc_base(self.ipc))} "
                               f"(platform {self.ipc.platform!r})")
         self._started = True
         self._zctx = zmq.Context(io_threads=max(1, self.cfg.router_threads))
@@ -153,7 +154,7 @@ class Broker:
                 rep.bind(endpoint)
                 self.manager_port = self.ipc.tcp_port if self.is_tcp else 0
                 if not self.is_tcp:
-                    self._ipc_files.append(f"{ipc_base(self.ipc)}.manager")
+                    self._ipc_files.append(ipc_manager_path(ipc_base(self.ipc)))
         except zmq.ZMQError as exc:
             rep.close()
             self.stop()

@@ -16,6 +16,11 @@ def ipc_base(cfg: InterProcessPortalConfig) -> str:
     return cfg.socket_name if cfg.HasField("socket_name") else f"/tmp/goby_{cfg.platform}"
 
 
+def ipc_manager_path(base: str) -> str:
+    """The manager's socket file for IPC base path ``base``: it exists while a broker serves that base."""
+    return f"{base}.manager"
+
+
 def ip_address(cfg: InterProcessPortalConfig) -> str:
     """The configured address: ``ip_address`` when set, else ``ipv4_address``."""
     return cfg.ip_address if cfg.HasField("ip_address") else cfg.ipv4_address
@@ -35,7 +40,7 @@ def tcp_endpoint(address: str, port: int) -> str:
 def manager_endpoint(cfg: InterProcessPortalConfig) -> str:
     """The manager's REQ/REP endpoint; the broker binds the same configured address clients connect to."""
     if cfg.transport == InterProcessPortalConfig.IPC:
-        return f"ipc://{ipc_base(cfg)}.manager"
+        return f"ipc://{ipc_manager_path(ipc_base(cfg))}"
     return tcp_endpoint(ip_address(cfg), cfg.tcp_port)
 
 
