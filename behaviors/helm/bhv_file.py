@@ -194,6 +194,13 @@ def read_bhv_file(path: str | os.PathLike[str]) -> BehaviorFile:
         text = Path(path).read_text(encoding="utf-8")
     except OSError as exc:
         raise BehaviorFileError(str(path), 0, str(path), f"cannot read behaviour file: {exc.strerror}") from exc
+    except UnicodeDecodeError as exc:  # a binary or mis-encoded file: say where, not a traceback
+        line = exc.object[:exc.start].count(b"\n") + 1
+        raise BehaviorFileError(str(path), line, f"byte 0x{exc.object[exc.start]:02x}",
+                                f"not a UTF-8 text behaviour file (byte offset {exc.start})") from None
+    if "\x00" in text:
+        line = text[:text.index("\x00")].count("\n") + 1
+        raise BehaviorFileError(str(path), line, "NUL", "not a text behaviour file (it holds NUL bytes)")
     return parse_bhv_text(text, str(path))
 
 

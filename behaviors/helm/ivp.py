@@ -8,11 +8,16 @@ together over the product grid, the separable pieces of the other behaviours add
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
 from .errors import ParamError
 from .logic import is_number
+
+MAX_DOMAIN_POINTS = 10_000
+"""Most points one decision variable may have: the helm scores every point every iteration, so ``course:0:359:1e9``
+would exhaust memory; real domains have hundreds (course 360, depth 0:500:501)."""
 
 
 @dataclass(frozen=True)
@@ -59,15 +64,20 @@ class IvPDomain:
         if not name or not is_number(low_s) or not is_number(high_s):
             raise ParamError(f"domain '{spec}': low and high must be numbers")
         low, high = float(low_s), float(high_s)
+        if not (math.isfinite(low) and math.isfinite(high)):
+            raise ParamError(f"domain '{spec}': low and high must be finite")
         if pts_s.lower().startswith("delta="):
             step = pts_s.split("=", 1)[1]
-            if not is_number(step) or float(step) <= 0:
+            if not is_number(step) or not 0 < float(step) < math.inf:
                 raise ParamError(f"domain '{spec}': bad delta")
-            points = int((high - low) / float(step) + 1)
-        elif is_number(pts_s) and float(pts_s) == int(float(pts_s)):
-            points = int(float(pts_s))
+            count = (high - low) / float(step) + 1
+        elif is_number(pts_s) and math.isfinite(float(pts_s)) and float(pts_s).is_integer():
+            count = float(pts_s)
         else:
             raise ParamError(f"domain '{spec}': npts must be a whole number")
+        if count > MAX_DOMAIN_POINTS:
+            raise ParamError(f"domain '{spec}': {count:g} points; at most {MAX_DOMAIN_POINTS} are allowed")
+        points = int(count)
         if high < low or points < 1 or (high == low) != (points == 1):
             raise ParamError(f"domain '{spec}': need high >= low, and npts == 1 exactly when high == low")
         if extra and extra != ["optional"]:

@@ -8,6 +8,15 @@ from .errors import ParamError
 from .geometry import Point, Polygon, project
 from .logic import is_number
 
+MAX_POINTS = 10_000
+"""Most vertices a polygon or waypoint list may have (``radial:: pts=`` included).  pHelmIvP builds whatever is
+asked (``pts=100000000`` is 100 million vertices, gigabytes); a mission needs tens, so more is a bad parameter."""
+
+
+def _check_count(count: int, text: str) -> None:
+    if count > MAX_POINTS:
+        raise ParamError(f"'{text[:80]}' asks for {count} points; at most {MAX_POINTS} are allowed")
+
 _DISPLAY_KEYS = {
     "label", "label_color", "edge_color", "vertex_color", "vertex_size", "edge_size", "active", "msg",
     "source", "type", "time", "duration", "fill_color", "fill_transparency", "comment",
@@ -67,6 +76,7 @@ def parse_seglist(text: str) -> list[Point]:
         points = _pairs(text)
     if not points:
         raise ParamError(f"'{text}' holds no points")
+    _check_count(len(points), text)
     return points
 
 
@@ -91,9 +101,12 @@ def parse_polygon(text: str) -> Polygon:
     return poly
 
 
-def _radial(x: float, y: float, radius: float, pts: int, snap: float | None) -> Polygon:
-    if radius <= 0 or pts < 3:
-        raise ParamError(f"radial polygon needs radius > 0 and pts >= 3 (got radius={radius}, pts={pts})")
+def _radial(x: float, y: float, radius: float, pts: float, snap: float | None) -> Polygon:
+    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(radius) and radius > 0
+            and 3 <= pts <= MAX_POINTS):
+        raise ParamError(f"radial polygon needs finite x, y, radius > 0 and 3 <= pts <= {MAX_POINTS} "
+                         f"(got x={x:g}, y={y:g}, radius={radius:g}, pts={pts:g})")
+    pts = int(pts)
     delta = 360.0 / pts
     vertices = [project(x, y, delta / 2 + k * delta, radius) for k in range(pts)]
     poly = Polygon(vertices)
@@ -128,7 +141,7 @@ def _radial_keyed(body: str) -> Polygon:
     x = float(values["x"]) + float(values.get("shiftx", 0))
     y = float(values["y"]) + float(values.get("shifty", 0))
     snap = float(values["snap"]) if "snap" in values else None
-    return _radial(x, y, float(values["radius"]), int(float(values["pts"])), snap)
+    return _radial(x, y, float(values["radius"]), float(values["pts"]), snap)
 
 
 def _radial_short(body: str) -> Polygon:
@@ -136,4 +149,4 @@ def _radial_short(body: str) -> Polygon:
     if len(fields) < 4 or not all(is_number(f) for f in fields[:4]):
         raise ParamError(f"radial: expects x, y, radius, pts[, snap] (got '{body}')")
     snap = float(fields[4]) if len(fields) > 4 and is_number(fields[4]) else None
-    return _radial(float(fields[0]), float(fields[1]), float(fields[2]), int(float(fields[3])), snap)
+    return _radial(float(fields[0]), float(fields[1]), float(fields[2]), float(fields[3]), snap)

@@ -20,6 +20,9 @@ log = logging.getLogger(__name__)
 
 MAX_FREQ = 10_000  # Hz; far beyond any real frontseat, and keeps the loop period sane
 MAX_WARP = 10_000
+MAX_TICK_RATE = 1_000
+"""Most ticks per real second (FREQ x WARP): each tick handles lines, steps the model and writes NAV to every
+client, so 10000 x 10000 would leave no time to serve them; the missions run 10 x 10-20."""
 
 
 @dataclass(frozen=True)
@@ -101,12 +104,16 @@ def parse_start(fields: dict[str, str]) -> StartParams:
         return value
 
     defaults = VehicleConfig()
+    freq, warp = integer("FREQ", 10, 1, MAX_FREQ), integer("WARP", 1, 1, MAX_WARP)
+    if freq * warp > MAX_TICK_RATE:
+        raise SimulatorLineError(f"Invalid START: FREQ {freq} x WARP {warp} = {freq * warp} ticks per real second; "
+                                 f"at most {MAX_TICK_RATE}")
     return StartParams(
         lat=lat,
         lon=lon,
         duration=integer("DURATION", 0, -INT_MAX, INT_MAX),
-        freq=integer("FREQ", 10, 1, MAX_FREQ),
-        warp=integer("WARP", 1, 1, MAX_WARP),
+        freq=freq,
+        warp=warp,
         vehicle=VehicleConfig(
             accel=real("ACCEL", defaults.accel),
             hdg_rate=real("HDG_RATE", defaults.hdg_rate),
@@ -160,7 +167,8 @@ class Simulation:
         """Act on one received line (without its ``\\r\\n``); return the replies to send to every client.
 
         Never raises: a line that cannot be acted on is logged with its cause. A CMD that cannot be applied
-        is answered ``CMD,RESULT:ERROR``; other bad lines get no reply (there is no reply type for them).
+        is answered ``CMD,RESULT:ERROR``, an invalid START ``START,RESULT:ERROR`` (so the driver's log says why
+        no ``CTRL,STATE:PAYLOAD`` comes); other bad lines get no reply (there is no reply type for them).
         """
         line = line.strip()
         key = protocol.line_key(line)
@@ -181,7 +189,7 @@ class Simulation:
             raise SimulatorLineError(f"Unknown key {key!r}")
         except SimulatorLineError as exc:
             log.warning("rejected line from payload %r: %s", _shorten(line), exc)
-            return [protocol.CMD_ERROR] if key == "CMD" else []
+            return {"CMD": [protocol.CMD_ERROR], "START": [protocol.START_ERROR]}.get(key, [])
 
     def tick(self) -> list[str]:
         """One iteration after the lines are handled: returns ``CTRL,STATE:IDLE`` or a NAV line, or nothing."""

@@ -20,6 +20,7 @@ CTRL_PAYLOAD = "CTRL,STATE:PAYLOAD"
 CTRL_IDLE = "CTRL,STATE:IDLE"
 CMD_OK = "CMD,RESULT:OK"
 CMD_ERROR = "CMD,RESULT:ERROR"
+START_ERROR = "START,RESULT:ERROR"  # ours: Goby's simulator answers an invalid START with nothing
 
 _DOUBLE = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.IGNORECASE)
 _INT = re.compile(r"[+-]?\d+")

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import resource
 import sys
 
 from gateway.goby.portal.broker import READY_PREFIX, Broker, BrokerError
@@ -20,6 +21,25 @@ from util.process import handle_signals
 
 log = logging.getLogger(__name__)
 
+MAX_OPEN_FILES = 1 << 20  # the soft limit asked for when the hard limit is unlimited
+
+
+def raise_open_files_limit() -> int:
+    """Raise the soft limit of open descriptors to the hard limit and return it.
+
+    Every connection is a descriptor; at the usual soft limit of 1024, a thousand half-open connections would fill
+    the table and no new client could connect until ZeroMQ's handshake timer closed them.
+    """
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    target = MAX_OPEN_FILES if hard == resource.RLIM_INFINITY else hard
+    if soft != resource.RLIM_INFINITY and soft < target:
+        try:
+            resource.setrlimit(resource.RLIMIT_NOFILE, (target, hard))
+            soft = target
+        except (ValueError, OSError) as exc:
+            log.warning("cannot raise the open-files limit from %d to %d: %s", soft, target, exc)
+    return soft
+
 
 def main(argv: list[str] | None = None) -> int:
     loaded = load_for_run(GobyDaemonConfig, argv, "goby-broker")
@@ -29,6 +49,7 @@ def main(argv: list[str] | None = None) -> int:
     configure_logging(loaded.verbosity, cfg.app.name)
     if not cfg.interprocess.HasField("platform"):
         log.warning("Using default platform name of %s", cfg.interprocess.platform)
+    log.debug("open-files limit: %d", raise_open_files_limit())
     broker = Broker(cfg)
     with handle_signals() as stop:
         try:

@@ -14,6 +14,7 @@ import math
 import sys
 from pathlib import Path
 
+from gateway.moos import database
 from gateway.moos.errors import MissionFileError
 from gateway.moos.mission_file import MissionFile
 from gateway.moos.server import MoosDB
@@ -22,6 +23,25 @@ from util.logsetup import add_verbosity_argument, configure_logging
 from util.process import handle_signals
 
 log = logging.getLogger(__name__)
+
+# --flag / mission-file global / default: the DB's bounds (a flag wins over the file, as for --moos_port)
+LIMITS = (
+    ("max_packet_bytes", "MaxPacketBytes", 64 * 1024 * 1024,
+     "largest packet accepted from a client before it is dropped (also the most unfinished input one connection "
+     "may buffer)"),
+    ("max_outbox_bytes", "MaxOutboxBytes", 16 * 1024 * 1024,
+     "unsent bytes one client may have queued before it is dropped as too slow"),
+    ("max_buffered_bytes", "MaxBufferedBytes", 256 * 1024 * 1024,
+     "input and output buffered for all connections together; past it the connection holding the most is dropped"),
+    ("max_variables", "MaxVariables", database.MAX_VARIABLES,
+     "variables the DB holds; a write or registration that would create more is refused and logged"),
+    ("max_variables_per_client", "MaxVariablesPerClient", database.MAX_VARIABLES_PER_CLIENT,
+     "variables one client name may create; past it its new variables are refused and logged"),
+    ("max_name_bytes", "MaxNameBytes", database.MAX_NAME_BYTES,
+     "longest client, variable, source, aux or community name; longer ones are refused"),
+    ("max_stored_bytes", "MaxStoredBytes", database.MAX_STORED_BYTES,
+     "bytes of names, values and aux stored for all variables; a write past it is refused and logged"),
+)
 
 _IGNORED_FLAGS = ("-s", "--single_threaded", "-b", "--moos_boost", "-d", "--dns", "--tcpnodelay",
                   "--print_heart_beat", "--moos_suicide_disable", "--moos_suicide_print", "--moos_no_colour")
@@ -57,14 +77,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="seconds of client silence before disconnect (default 5)")
     parser.add_argument("--moos_address", default="127.0.0.1",
                         help="address to bind (default 127.0.0.1; 0.0.0.0 for every interface like the C++ DB)")
-    parser.add_argument("--max_packet_bytes", type=bounded_number(int, 1), default=64 * 1024 * 1024,
-                        help="largest packet accepted from a client before it is dropped (also the most "
-                        "unfinished input one connection may buffer)")
-    parser.add_argument("--max_outbox_bytes", type=bounded_number(int, 1), default=16 * 1024 * 1024,
-                        help="unsent bytes one client may have queued before it is dropped as too slow")
-    parser.add_argument("--max_buffered_bytes", type=bounded_number(int, 1), default=256 * 1024 * 1024,
-                        help="input and output buffered for all connections together; past it the connection "
-                        "holding the most is dropped")
+    for flag, param, default, text in LIMITS:
+        parser.add_argument(f"--{flag}", type=bounded_number(int, 1),
+                            help=f"{text} (default {param} in the mission file, else {default})")
     parser.add_argument("--response", default="",
                         help="name:ms or pattern:ms, comma separated: ask those async clients to write no more "
                         "often than that (sent in the timing reply, as MOOSDB does)")
@@ -88,6 +103,7 @@ def main(argv: list[str] | None = None) -> int:
             log.info("option --%s has no effect here and is ignored", name[len("ignored_"):])
 
     port, community, warp, timeout = 9000, "#1", 1.0, 5.0
+    limits = {flag: default for flag, _, default, _ in LIMITS}
     path = args.moos_file or args.mission_file
     if path is None and Path("Mission.moos").exists():
         path = "Mission.moos"
@@ -97,6 +113,12 @@ def main(argv: list[str] | None = None) -> int:
             mission.check()
             port, community, warp = mission.server_port, mission.community, mission.time_warp
             timeout = mission.global_number("ClientTimeout", 0, math.inf, low_inclusive=False) or timeout
+            for flag, param, _, _ in LIMITS:
+                value = mission.global_number(param, 1, 2**62)
+                if value is not None:
+                    if value != int(value):
+                        raise MissionFileError(f"{path}: {param} = {value:g} is not a whole number")
+                    limits[flag] = int(value)
         except MissionFileError as exc:
             log.error("mission file not usable: %s", exc)
             return 2
@@ -108,12 +130,14 @@ def main(argv: list[str] | None = None) -> int:
         warp = args.moos_time_warp
     if args.moos_timeout is not None:
         timeout = args.moos_timeout
+    for flag in limits:
+        if getattr(args, flag) is not None:
+            limits[flag] = getattr(args, flag)
 
     try:
         response = parse_response(args.response)
         server = MoosDB(args.moos_address, port, community, time_warp=warp, client_timeout=timeout,
-                        max_packet_bytes=args.max_packet_bytes, max_outbox_bytes=args.max_outbox_bytes,
-                        max_buffered_bytes=args.max_buffered_bytes, response=response)
+                        response=response, **limits)
         server.start()
     except (OSError, ValueError) as exc:
         log.error("cannot start the MOOSDB on %s:%d: %s", args.moos_address, port, exc)

@@ -16,6 +16,13 @@ written batch is only *confirmed* when the DB has processed it: an asynchronous 
 message whose id the DB echoes after processing the packet, a synchronous one gets its reply. Batches written but
 unconfirmed when the connection is lost (the message in flight at a crash) are reported undelivered through the
 on-undelivered callback and a counter, never assumed sent; so are messages discarded by ``close``.
+
+A confirmed message reaches the clients registered for it *when the DB processed it*. So that a restart does not
+lose what is published before a subscriber has registered again, a client that publishes asks the DB every second
+which clients subscribe to what (``PROC_SUMMARY``, as uMS does). After a reconnection, posts of a variable that had
+other subscribers are refused (False, counted) and its queued mail is held until the DB lists those subscribers
+again (polled every 50 ms; given up after ``RESUBSCRIBE_WAIT_S``, with a WARNING naming them). What to ask, hold
+and release is decided by ``subscriber_watch.py``; this module sends, logs and moves the mail.
 """
 
 from __future__ import annotations
@@ -33,6 +40,13 @@ from .codec import PacketReader, encode_fields, encode_message, frame_packet
 from .connection import PacketSocket, Welcome, client_handshake, open_socket
 from .errors import ConnectionClosedError, HandshakeError, MoosError, PoisonedError, ProtocolError
 from .message import DOUBLE, NOTIFY, NULL_MSG, TIMING, TIMING_KEY, MoosMessage, to_bytes
+from .subscriber_watch import (
+    RESUBSCRIBE_WAIT_S,
+    SubscriberWatch,
+    is_summary_reply,
+    parse_proc_summary,
+    summary_request,
+)
 
 log = logging.getLogger(__name__)
 
@@ -109,6 +123,8 @@ class ClientEngine:
         self._refused = 0  # posts refused because the link was down
         self._undelivered = 0  # accepted posts reported undelivered (in flight at a crash, or discarded by close)
         self._on_undelivered: UndeliveredCallback | None = None
+        # Who else subscribes to the variables we publish, and what waits for them after a reconnection.
+        self._watch = SubscriberWatch()
         self.welcome: Welcome | None = None  # the DB's last WELCOME (community, skew, DB time, hostname)
 
     @property
@@ -183,7 +199,8 @@ class ClientEngine:
         """Encode a message at once and get it written: directly if the link is idle, else by the writer."""
         on_io_thread = threading.get_ident() == self._io_ident
         with self._lock:
-            if not self._live:
+            missing = self._watch.missing
+            if not self._live or (missing and msg_type == NOTIFY and key in missing):
                 self._refused += 1
                 return False
             if msg_id is None:
@@ -235,6 +252,9 @@ class ClientEngine:
             timing = MoosMessage(TIMING, DOUBLE, msg_id=self._token, key=TIMING_KEY,
                                  msg_time=self._clock.local_time(), dval=0.0)
             batch = [encode_message(timing), *batch]
+        summary = self._summary_request(_time.monotonic())
+        if summary is not None:
+            batch.append(summary)
         if self._space_waiters:
             self._cond.notify_all()
         return batch, self._conn
@@ -273,7 +293,10 @@ class ClientEngine:
         """Async writer: batch what is queued, keep the timing message going, honour the DB's delay."""
         while not self._stop.is_set():
             with self._lock:
-                timing_due = self._last_timing + TIMING_PERIOD_S - _time.monotonic()
+                now = _time.monotonic()
+                timing_due = self._last_timing + TIMING_PERIOD_S - now
+                # while waiting for subscribers to register again, ask the DB soon
+                timing_due = min(timing_due, self._watch.next_poll_in(now))
                 if self._busy or not self._writable or (not self._outbox and timing_due > 0):
                     self._writer_waiting = True
                     self._cond.wait(min(WRITER_IDLE_WAKE_S, max(timing_due, 0.001)))
@@ -340,6 +363,7 @@ class ClientEngine:
         self._reregister()
         self._run_callback(self._on_connect, "on-connect")
         with self._lock:  # what was queued while down, or by on-connect, goes now: after the re-registrations
+            self._outbox = self._watch.reconnected(_time.monotonic(), self._outbox)
             self._writable = True
             self._cond.notify_all()
         self._reregistered = set()  # only on-connect's repeats of the automatic registrations are skipped
@@ -366,6 +390,7 @@ class ClientEngine:
             self._bytes_read_total += conn.bytes_read
             in_doubt = [batch for _, batch in self._unconfirmed]
             self._unconfirmed.clear()
+            self._watch.lost()  # what we publish to others waits, after reconnecting, for them to be back
             self._cond.notify_all()
         conn.close()
         if in_doubt:
@@ -376,6 +401,35 @@ class ClientEngine:
             log.info("%s: %d queued message(s) will be sent after reconnecting", self._name, len(self._outbox))
         if was_connected:
             self._run_callback(self._on_disconnect, "on-disconnect")
+
+    # ---- subscribers of what we publish (subscriber_watch.py decides) --------------------------------
+    def _summary_request(self, now: float) -> bytes | None:
+        """Under the lock: a ``PROC_SUMMARY`` request when one is due (we publish something), else None; gives up
+        waiting for subscribers that have not come back within ``RESUBSCRIBE_WAIT_S``."""
+        poll = self._watch.poll(now, bool(self._published))
+        if poll.gave_up:
+            log.warning("%s: subscriber(s) of %s did not register again within %.1f s of reconnecting; publishing "
+                        "to those variables again", self._name,
+                        ", ".join(sorted(k.decode(errors="replace") for k in poll.gave_up)), RESUBSCRIBE_WAIT_S)
+            self._release_held(poll.release)
+        return summary_request(self._src, self._clock.time()) if poll.ask else None
+
+    def _release_held(self, held: list[bytes]) -> None:
+        """Under the lock: held mail goes before anything queued since (it is older)."""
+        if held:
+            self._outbox[:0] = held
+            self._cond.notify_all()
+
+    def _on_summary(self, replies: list[MoosMessage]) -> None:
+        """The DB's answer to our ``PROC_SUMMARY``; releases the variables whose subscribers are all back. Runs on
+        the I/O thread."""
+        published = [to_bytes(name) for name in list(self._published)]
+        subscribers = parse_proc_summary((reply.raw_sval for reply in replies), self._src, published)
+        with self._lock:
+            released = self._watch.summary(subscribers)
+            if released is not None:
+                log.info("%s: the subscribers of what we publish have registered again", self._name)
+                self._release_held(released)
 
     def _confirm(self, token: int | None) -> None:
         """The DB has processed every batch up to ``token`` (None: everything written)."""
@@ -428,6 +482,10 @@ class ClientEngine:
                 if batch:
                     self._unconfirmed.append((0, batch))
                 self._cond.notify_all()
+            with self._lock:
+                summary = self._summary_request(_time.monotonic())
+            if summary is not None:
+                batch = [*batch, summary]
             if not batch:
                 batch = [encode_message(MoosMessage(NULL_MSG, DOUBLE, src=self._src))]
             tx = self._clock.local_time()
@@ -455,6 +513,13 @@ class ClientEngine:
         mail = [m for m in packet if m.msg_type != NULL_MSG]
         if not mail:
             return
+        if self._watch.pending:
+            summary = [m for m in mail if is_summary_reply(m)]
+            if summary:
+                self._on_summary(summary)
+                mail = [m for m in mail if not is_summary_reply(m)]
+                if not mail:
+                    return
         self._messages_read += len(mail)
         if self._queues:
             dispatch = self._queues.dispatch

@@ -3,7 +3,8 @@
 Global parameters follow ``GetValue``: whitespace is removed from the whole line, the name is matched
 case-insensitively, and the first match anywhere in the file wins (inside ProcessConfig blocks too).
 Process blocks follow ``GetConfigurationAndPreserveSpace``: file order, keys as written, values trimmed
-with their internal spaces kept.
+with their internal spaces kept. A file that is not text (a NUL byte, or mostly bytes that are neither UTF-8 nor
+printable) is refused, naming file and line: libMOOS would read it as an empty mission and serve on defaults.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ from .errors import MissionFileError
 log = logging.getLogger(__name__)
 
 MAX_LINE_CHARS = 2000
+MAX_NON_TEXT_FRACTION = 0.1  # a stray Latin-1 byte in a comment is fine; a binary file is not
+_CONTROL = re.compile(r"[\x00-\x08\x0b\x0e-\x1f\x7f]|[\udc80-\udcff]")
 _DEFINE = re.compile(r"^define\s*:\s*([^=\s]+)\s*=\s*(.*)$", re.IGNORECASE)
 _REFERENCE = re.compile(r"\$\{([^}]*)\}")
 _WHITESPACE = re.compile(r"[ \t]+")
@@ -49,6 +52,19 @@ class MissionFile:
             raise MissionFileError(f"cannot read mission file {self.path}: {exc.strerror or exc}") from exc
         self._lines, self._numbers = self._valid_lines(text)
 
+    def _check_text(self, text: str) -> None:
+        """Raise ``MissionFileError`` for a file that is not text: a NUL, or too many control/undecodable bytes."""
+        nul = text.find("\0")
+        bad = nul if nul >= 0 else -1
+        if bad < 0:
+            odd = _CONTROL.findall(text)
+            if len(odd) <= MAX_NON_TEXT_FRACTION * max(len(text), 1):
+                return
+            bad = _CONTROL.search(text).start()  # type: ignore[union-attr]
+        line = text.count("\n", 0, bad) + 1
+        what = "a NUL byte" if nul >= 0 else "mostly control characters or bytes that are not UTF-8"
+        raise MissionFileError(f"{self.path}:{line}: not a text mission file ({what}); is it the right file?")
+
     @classmethod
     def from_text(cls, text: str, name: str = "<string>") -> MissionFile:
         """Parse mission-file text that is not on disk (handy for generated missions and tests)."""
@@ -59,6 +75,7 @@ class MissionFile:
 
     def _valid_lines(self, text: str) -> tuple[list[str], list[int]]:
         """The lines ``GetNextValidLine`` would return (trimmed, uncommented, defines expanded) and their numbers."""
+        self._check_text(text)
         defines: dict[str, str] = {}
         lines: list[str] = []
         numbers: list[int] = []

@@ -8,7 +8,14 @@ bounded outbox (``max_outbox_bytes``); a client whose outbox overflows, or that 
 thread for the same reason, see docs/moos.md "Slow clients and memory"). Input is bounded per connection by
 ``max_packet_bytes`` (a partial packet cannot grow past it) and all buffered input and output together by
 ``max_buffered_bytes``: past it, the connection holding the most is dropped and named. Any client that sends
-bad bytes is dropped alone, with the reason logged; the others carry on.
+bad bytes is dropped alone, with the reason logged; the others carry on. A connection's state and the timeouts
+that drop it are in ``server_client.py``; the DB's logic, free of sockets, in ``database.py``.
+
+Silence is measured up to the last ``select``, not to "now": when the loop itself was busy (a big request, a
+stalled machine), bytes a client sent meanwhile wait in the kernel, and the client is not blamed for them.
+A second connection with a connected client's name is refused (POISON, as MOOSDB), naming the address that holds
+the name, unless that holder has been silent for half the client timeout: then it is presumed dead (a
+half-open socket after a network drop or a DB restart) and replaced, so the real client is not locked out.
 """
 
 from __future__ import annotations
@@ -18,7 +25,6 @@ import selectors
 import socket
 import threading
 import time as _time
-from collections import deque
 
 from util.memory import release_freed_memory
 from util.sockets import accept_client
@@ -33,6 +39,8 @@ from .codec import (
     frame_packet,
 )
 from .database import MoosDatabase
+from .db_jobs import JOB_SLICE_S
+from .db_limits import MAX_NAME_BYTES, MAX_STORED_BYTES, MAX_VARIABLES, MAX_VARIABLES_PER_CLIENT, preview
 from .errors import MoosError, ProtocolError
 from .message import (
     ASYNC_KEY,
@@ -47,6 +55,7 @@ from .message import (
     to_bytes,
     to_str,
 )
+from .server_client import CLOSED, HELLO, PROTOCOL, READY, ServerClient, timeout_reason
 from .wildcard import wild_match
 
 log = logging.getLogger(__name__)
@@ -57,33 +66,6 @@ MAX_OUTBOX_BYTES = 16 * 1024 * 1024
 MAX_BUFFERED_BYTES = 256 * 1024 * 1024
 SEND_CHUNK = 1024 * 1024
 TRIM_AFTER_BYTES = 64 * 1024
-
-_PROTOCOL, _HELLO, _READY, _CLOSED = range(4)
-
-
-class _Client:
-    """One accepted connection and its state."""
-
-    __slots__ = ("sock", "peer", "state", "proto_buf", "reader", "name", "asynchronous", "last_rx", "accepted",
-                 "out", "out_bytes", "last_progress", "events", "held")
-
-    def __init__(self, sock: socket.socket, peer: str, max_packet_bytes: int) -> None:
-        self.sock = sock
-        self.peer = peer
-        self.state = _PROTOCOL
-        self.proto_buf = b""
-        self.reader = PacketReader(max_packet_bytes)
-        self.name = b""
-        self.asynchronous = False
-        self.accepted = self.last_rx = self.last_progress = _time.monotonic()
-        self.out: deque[bytes] = deque()
-        self.out_bytes = 0
-        self.events = 0
-        self.held = 0  # input + output bytes buffered for this client, as last counted in the DB's total
-
-    def label(self) -> str:
-        return f"{to_str(self.name)!r} ({self.peer})" if self.name else self.peer
-
 
 class MoosDB:
     """A MOOSDB. ``start()`` binds (``port=0`` picks a free port, see ``.port``) and serves on a thread."""
@@ -101,6 +83,10 @@ class MoosDB:
         max_outbox_bytes: int = MAX_OUTBOX_BYTES,
         max_buffered_bytes: int = MAX_BUFFERED_BYTES,
         response: dict[str, float] | None = None,
+        max_variables: int = MAX_VARIABLES,
+        max_variables_per_client: int = MAX_VARIABLES_PER_CLIENT,
+        max_name_bytes: int = MAX_NAME_BYTES,
+        max_stored_bytes: int = MAX_STORED_BYTES,
     ) -> None:
         self.host = host
         self._requested_port = int(port)
@@ -116,7 +102,11 @@ class MoosDB:
         # MOOSDB's --response: client name or wildcard pattern -> seconds asked between the client's writes
         self.response = {to_bytes(k): float(v) for k, v in (response or {}).items()}
         self.max_packet_bytes = max_packet_bytes
-        self.db = MoosDatabase(community, self.clock)
+        self.db = MoosDatabase(community, self.clock, max_variables=max_variables,
+                               max_variables_per_client=max_variables_per_client, max_name_bytes=max_name_bytes,
+                               max_stored_bytes=max_stored_bytes)
+        self.max_name_bytes = int(max_name_bytes)
+        self._last_select = _time.monotonic()  # silence is measured up to here: the loop was listening then
         self._hostname = to_bytes(socket.gethostname())
         self._listener: socket.socket | None = None
         self._selector: selectors.BaseSelector | None = None
@@ -124,8 +114,8 @@ class MoosDB:
         self._wake_w: socket.socket | None = None
         self._thread: threading.Thread | None = None
         self._stopping = threading.Event()
-        self._clients: dict[int, _Client] = {}
-        self._by_name: dict[bytes, _Client] = {}
+        self._clients: dict[int, ServerClient] = {}
+        self._by_name: dict[bytes, ServerClient] = {}
         self._lock = threading.Lock()
         self._recv_buf = bytearray(RECV_BYTES)
         self._recv_view = memoryview(self._recv_buf)
@@ -199,8 +189,11 @@ class MoosDB:
         assert sel is not None
         next_check = _time.monotonic() + 0.25
         try:
+            db = self.db
             while not self._stopping.is_set():
-                for key, mask in sel.select(timeout=0.25):
+                events = sel.select(timeout=0.0 if db.jobs_pending else 0.25)
+                self._last_select = _time.monotonic()
+                for key, mask in events:
                     obj = key.fileobj
                     if obj is self._listener:
                         self._accept()
@@ -211,15 +204,18 @@ class MoosDB:
                             pass
                     else:
                         client = key.data
-                        if mask & selectors.EVENT_WRITE and client.state != _CLOSED:
+                        if mask & selectors.EVENT_WRITE and client.state != CLOSED:
                             self._flush(client)
-                        if mask & selectors.EVENT_READ and client.state != _CLOSED:
+                        if mask & selectors.EVENT_READ and client.state != CLOSED:
                             self._read(client)
+                if db.jobs_pending:
+                    db.run_jobs(JOB_SLICE_S)
                 self._push_waiting_mail()
                 now = _time.monotonic()
                 if now >= next_check:
                     next_check = now + 0.25
-                    self._check_timeouts(now)
+                    self._check_timeouts(self._last_select)
+                    db.flush_warnings()
                     if self._trim_due:
                         self._trim_due = False
                         release_freed_memory()
@@ -247,14 +243,14 @@ class MoosDB:
         if accepted is None:
             return
         sock, peer = accepted
-        client = _Client(sock, peer, self.max_packet_bytes)
+        client = ServerClient(sock, peer, self.max_packet_bytes)
         self._clients[sock.fileno()] = client
         self._set_events(client)
         log.debug("accepted a connection from %s", client.peer)
 
-    def _set_events(self, client: _Client) -> None:
+    def _set_events(self, client: ServerClient) -> None:
         want = selectors.EVENT_READ | (selectors.EVENT_WRITE if client.out else 0)
-        if want == client.events or client.state == _CLOSED:
+        if want == client.events or client.state == CLOSED:
             return
         sel = self._selector
         assert sel is not None
@@ -267,7 +263,7 @@ class MoosDB:
         client.events = want
 
     # ---- reading -----------------------------------------------------------------------------------
-    def _read(self, client: _Client) -> None:
+    def _read(self, client: ServerClient) -> None:
         try:
             n = client.sock.recv_into(self._recv_buf)
         except (BlockingIOError, InterruptedError):
@@ -276,7 +272,7 @@ class MoosDB:
             self._close(client, f"read failed: {exc}", fault=False)
             return
         if not n:
-            partial = client.reader.pending_bytes or (client.state == _PROTOCOL and len(client.proto_buf))
+            partial = client.reader.pending_bytes or (client.state == PROTOCOL and len(client.proto_buf))
             if partial:
                 self._close(client, f"closed the connection in the middle of a packet ({partial} bytes unfinished)")
             else:
@@ -284,7 +280,7 @@ class MoosDB:
             return
         data = self._recv_view[:n]  # one reused buffer: a fresh 256 KiB bytes per recv would cost an mmap
         client.last_rx = _time.monotonic()
-        if client.state == _PROTOCOL:
+        if client.state == PROTOCOL:
             need = PROTOCOL_STRING_SIZE - len(client.proto_buf)
             client.proto_buf += bytes(data[:need])
             data = data[need:]
@@ -294,33 +290,33 @@ class MoosDB:
             if offered.lower() != PROTOCOL_STRING.lower():
                 self._close(client, f"incompatible wire protocol: sent {offered[:40]!r}, expected {PROTOCOL_STRING!r}")
                 return
-            client.state = _HELLO
+            client.state = HELLO
             if not data:
                 return
         try:
             packets = client.reader.feed(data)
         except ProtocolError as exc:
             for packet in exc.packets:
-                if client.state == _CLOSED or not self._on_packet(client, packet):
+                if client.state == CLOSED or not self._on_packet(client, packet):
                     return
             self._close(client, f"malformed packet: {exc}")
             return
         for packet in packets:
-            if client.state == _CLOSED or not self._on_packet(client, packet):
+            if client.state == CLOSED or not self._on_packet(client, packet):
                 return
         self._account(client)
 
-    def _on_packet(self, client: _Client, packet: list[MoosMessage]) -> bool:
-        if client.state == _HELLO:
+    def _on_packet(self, client: ServerClient, packet: list[MoosMessage]) -> bool:
+        if client.state == HELLO:
             return self._handshake(client, packet)
         try:
             self._process(client, packet)
         except MoosError as exc:
             self._close(client, str(exc))
             return False
-        return client.state != _CLOSED
+        return client.state != CLOSED
 
-    def _handshake(self, client: _Client, packet: list[MoosMessage]) -> bool:
+    def _handshake(self, client: ServerClient, packet: list[MoosMessage]) -> bool:
         """The client's first packet names it: POISON a duplicate or empty name, else WELCOME."""
         if not packet:
             return self._poison(client, "Failed to read receive client's name")
@@ -330,8 +326,15 @@ class MoosDB:
             return self._poison(client, f"expected a MOOS_DATA handshake message, got type {hello.type()!r}")
         if not name:
             return self._poison(client, "Failed to read receive client's name (empty)")
-        if name in self._by_name:
-            return self._poison(client, f'A client of this name ("{to_str(name)}") already exists')
+        if len(name) > self.max_name_bytes:
+            return self._poison(client, f"client name {preview(name)} is longer than max_name_bytes "
+                                f"({self.max_name_bytes})")
+        holder = self._by_name.get(name)
+        if holder is not None and not self._replace_stale(holder, client):
+            log.warning("refusing a second client named %r from %s: that name is connected from %s (heard from "
+                        "%.1f s ago)", to_str(name), client.peer, holder.peer, self._last_select - holder.last_rx)
+            return self._poison(client, f'A client of this name ("{to_str(name)}") already exists '
+                                f"(connected from {holder.peer})")
         now = self.clock.time()
         welcome = MoosMessage(
             WELCOME, DOUBLE, aux=b"hostname=" + self._hostname, community=self.db.community,
@@ -339,22 +342,36 @@ class MoosDB:
         )
         client.name = name
         client.asynchronous = hello.raw_key.lower() == ASYNC_KEY
-        client.state = _READY
+        client.state = READY
         with self._lock:
             self._by_name[name] = client
         self._send(client, frame_packet([encode_message(welcome)]))
         self.db.connect(name, client.asynchronous)
         log.info("client %s connected (%s)", client.label(), "asynchronous" if client.asynchronous else "synchronous")
-        return client.state != _CLOSED
+        return client.state != CLOSED
 
-    def _poison(self, client: _Client, reason: str) -> bool:
+    def _replace_stale(self, holder: ServerClient, newcomer: ServerClient) -> bool:
+        """Drop ``holder`` for ``newcomer`` if it has been silent for half the client timeout; True if dropped.
+
+        A live client writes at least once a second (the async timing message, the sync poll), so such silence
+        means a dead peer whose socket the DB has not noticed yet; refusing the newcomer would POISON the real
+        client (fatal to libMOOS and to ours) and lock it out for good.
+        """
+        silent = self._last_select - holder.last_rx
+        if silent < self.client_timeout / 2:
+            return False
+        self._close(holder, f"replaced by a new connection of the same name from {newcomer.peer} after "
+                    f"{silent:.1f} s of silence")
+        return True
+
+    def _poison(self, client: ServerClient, reason: str) -> bool:
         poison = MoosMessage(POISON, STRING, msg_time=self.clock.time(), sval=to_bytes(reason))
         self._send(client, frame_packet([encode_message(poison)]))
         self._flush(client)
         self._close(client, f"refused: {reason}")
         return False
 
-    def _process(self, client: _Client, packet: list[MoosMessage]) -> None:
+    def _process(self, client: ServerClient, packet: list[MoosMessage]) -> None:
         """One packet through the DB; reply as the ThreadedCommServer does for sync and async clients."""
         db = self.db
         timing = None
@@ -364,7 +381,7 @@ class MoosDB:
             db.record_timing(client.name, (now_local - timing.msg_time) * 1000.0 / self.clock.warp)
             timing.dval = now_local
             timing.dval2 = self._response_delay(client.name)
-        replies, _ = db.process(packet)
+        replies, _ = db.process(packet, client.name)
         out: list[bytes] = []
         if not client.asynchronous:
             out.append(encode_message(MoosMessage(NULL_MSG, DOUBLE, dval=self.clock.local_time())))
@@ -405,8 +422,8 @@ class MoosDB:
                     self._send(client, frame_packet(mail))
 
     # ---- writing -----------------------------------------------------------------------------------
-    def _send(self, client: _Client, data: bytes) -> None:
-        if client.state == _CLOSED:
+    def _send(self, client: ServerClient, data: bytes) -> None:
+        if client.state == CLOSED:
             return
         if not client.out:
             try:
@@ -429,7 +446,7 @@ class MoosDB:
         self._set_events(client)
         self._account(client)
 
-    def _flush(self, client: _Client) -> None:
+    def _flush(self, client: ServerClient) -> None:
         while client.out:
             chunk = client.out[0]
             if len(client.out) > 1 and len(chunk) < SEND_CHUNK:
@@ -458,9 +475,9 @@ class MoosDB:
         self._account(client)
 
     # ---- memory bounds -----------------------------------------------------------------------------
-    def _account(self, client: _Client) -> None:
+    def _account(self, client: ServerClient) -> None:
         """Update the total of buffered bytes with this client's; past ``max_buffered_bytes`` drop the biggest."""
-        if client.state == _CLOSED:
+        if client.state == CLOSED:
             return
         held = client.reader.pending_bytes + client.out_bytes
         self.buffered_bytes += held - client.held
@@ -473,19 +490,15 @@ class MoosDB:
     # ---- timeouts and closing ----------------------------------------------------------------------
     def _check_timeouts(self, now: float) -> None:
         for client in list(self._clients.values()):
-            if client.state in (_PROTOCOL, _HELLO):
-                if now - client.accepted > self.handshake_timeout:
-                    self._close(client, f"no handshake within {self.handshake_timeout:g} s")
-            elif client.out_bytes and now - client.last_progress > self.stall_timeout:
-                self._close(client, f"not reading: {client.out_bytes} bytes unsent for {self.stall_timeout:g} s")
-            elif now - client.last_rx > self.client_timeout:
-                self._close(client, f"disconnecting after {self.client_timeout:g} seconds of silence")
+            reason = timeout_reason(client, now, self.handshake_timeout, self.stall_timeout, self.client_timeout)
+            if reason is not None:
+                self._close(client, reason)
 
-    def _close(self, client: _Client, reason: str | None, fault: bool = True) -> None:
-        if client.state == _CLOSED:
+    def _close(self, client: ServerClient, reason: str | None, fault: bool = True) -> None:
+        if client.state == CLOSED:
             return
-        was_ready = client.state == _READY
-        client.state = _CLOSED
+        was_ready = client.state == READY
+        client.state = CLOSED
         if reason is not None:
             if fault:
                 log.warning("dropping client %s: %s", client.label(), reason)

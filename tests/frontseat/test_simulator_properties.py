@@ -31,7 +31,7 @@ def test_no_line_makes_the_model_raise(lines: list[str]) -> None:
     sim.handle_line("START,LAT:41.5,LON:-70.7")
     for line in lines:
         replies = sim.handle_line(line)
-        assert set(replies) <= {protocol.CTRL_PAYLOAD, protocol.CMD_OK, protocol.CMD_ERROR}
+        assert set(replies) <= {protocol.CTRL_PAYLOAD, protocol.CMD_OK, protocol.CMD_ERROR, protocol.START_ERROR}
         for out in sim.tick():
             assert out == protocol.CTRL_IDLE or out.startswith("NAV,")
         assert sim.period > 0

@@ -9,21 +9,33 @@ and acks), ``signal_transmit_result`` (what was sent). All run on the thread tha
 running frame counter, ``max_frame_bytes`` from the slot (else ``rate_to_bytes``, else ``max_frame_size``),
 nothing sent for an empty slot, the serialized ``ModemTransmission`` as the whole datagram, own datagrams dropped
 by ``src``, and an immediate ACK for unicast data addressed to us. Subclasses only move bytes.
+
+A datagram is remote input: before anything is acked or emitted, its fields are range-checked (``src``, frame
+numbers, no more frames or acked frames than a slot allows); a datagram that fails is dropped, counted in
+``refused`` by cause and logged at a rate-limited cadence, and nothing a datagram makes the link code raise ends
+the link's thread. Only data from the link's ``peers`` (set by the link from its slot plan) is acked.
 """
 
 from __future__ import annotations
 
 import abc
 import logging
-from collections.abc import Callable
+from collections import Counter
+from collections.abc import Callable, Collection
 from typing import Generic, TypeVar
 
 from google.protobuf.message import DecodeError
 
 from gateway.goby.acomms.protobuf.driver_base_pb2 import DriverConfig
 from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
+from util.ratelimit import RateLimitedLog
 
 log = logging.getLogger(__name__)
+
+#: Frame numbers and acked frames travel as int32 (``acked_frame``): a frame number past this is out of range.
+MAX_FRAME_NUMBER = 2**31 - 1
+#: Seconds between two log lines of the same kind of refused datagram (the first is logged at once).
+REFUSED_LOG_PERIOD_S = 10.0
 
 T = TypeVar("T")
 
@@ -49,6 +61,16 @@ class ModemDriver(abc.ABC):
         self.signal_data_request: Signal[ModemTransmission] = Signal()
         self.signal_receive: Signal[ModemTransmission] = Signal()
         self.signal_transmit_result: Signal[ModemTransmission] = Signal()
+        self.peers: frozenset[int] | None = None  # wire ids we ack data from (None: any)
+        self.max_frames = 1  # frames (and acked frames) one transmission may carry on this link
+        self.name = ""  # for log lines: which link this driver serves (default: "modem <id>")
+
+    def expect(self, name: str, peers: Collection[int] | None, max_frames: int) -> None:
+        """What the link allows (call before ``startup``): the wire ids of its peers (None: any) and the most
+        frames a slot carries. Goby's driver acks and passes on anything; ours refuses the rest at the edge."""
+        self.name = name
+        self.peers = None if peers is None else frozenset(peers)
+        self.max_frames = max(1, max_frames)
 
     @abc.abstractmethod
     def startup(self, cfg: DriverConfig) -> None:
@@ -77,7 +99,9 @@ class DatagramDriver(ModemDriver):
         self._next_frame = 0
         self.sent = 0  # datagrams sent (data and acks)
         self.received = 0  # datagrams received from others
-        self.malformed = 0
+        self.malformed = 0  # datagrams that are not a ModemTransmission
+        self.refused: Counter[str] = Counter()  # datagrams dropped at the edge, by cause (malformed included)
+        self.refusals = RateLimitedLog(log, REFUSED_LOG_PERIOD_S)
 
     # -------------------------------------------------------------------------------------- transport
     @abc.abstractmethod
@@ -96,6 +120,7 @@ class DatagramDriver(ModemDriver):
     def startup(self, cfg: DriverConfig) -> None:
         self.cfg = cfg
         self.modem_id = cfg.modem_id
+        self.name = self.name or f"modem {cfg.modem_id}"
 
     def handle_initiate_transmission(self, msg: ModemTransmission) -> None:
         msg.src = self.modem_id
@@ -104,12 +129,25 @@ class DatagramDriver(ModemDriver):
             msg.max_frame_bytes = self._max_frame_size(msg)
         self.signal_data_request.emit(msg)
         self._next_frame += max(1, len(msg.frame))
+        if self._next_frame + self.max_frames > MAX_FRAME_NUMBER:
+            self._next_frame = 0  # after 2^31 frames: our frame numbers stay in the range peers accept
         if msg.frame and msg.frame[0]:
             self._transmit(msg)
 
     def do_work(self) -> None:
         for datagram in self._receive_all():
-            self._handle_datagram(datagram)
+            try:
+                self._handle_datagram(datagram)
+            except Exception as exc:  # noqa: BLE001 - what a datagram makes us raise must not end the link
+                self.refuse("failed", "handling it failed (%s: %s)", type(exc).__name__, exc, size=len(datagram))
+                log.debug("%s: the datagram that failed: %r", self.name, datagram[:256], exc_info=True)
+        self.refusals.flush()
+
+    def refuse(self, cause: str, why: str, *args: object, size: int) -> None:
+        """Count a dropped datagram under ``cause`` and log it (rate-limited per cause)."""
+        self.refused[cause] += 1
+        self.refusals.error(cause, "%s: dropping a datagram (%d bytes): " + why + " [%s: %d dropped so far]",
+                            self.name, size, *args, cause, self.refused[cause])
 
     # ------------------------------------------------------------------------------------------ logic
     def _transmit(self, msg: ModemTransmission) -> None:
@@ -117,19 +155,39 @@ class DatagramDriver(ModemDriver):
         self.sent += 1
         self.signal_transmit_result.emit(msg)
 
+    def out_of_range(self, msg: ModemTransmission) -> tuple[str, str] | None:
+        """The field of ``msg`` that is out of range and why, or None."""
+        if msg.src < 0:
+            return "src", f"src {msg.src} is not a modem id"
+        if msg.dest < -1:
+            return "dest", f"dest {msg.dest} is not a modem id"
+        if len(msg.frame) > self.max_frames:
+            return "frame", f"{len(msg.frame)} frames, more than the {self.max_frames} a slot of this link carries"
+        if len(msg.acked_frame) > self.max_frames:
+            return "acked_frame", (f"{len(msg.acked_frame)} acked frames, more than the {self.max_frames} a slot of "
+                                   "this link carries")
+        if msg.frame_start + max(0, len(msg.frame) - 1) > MAX_FRAME_NUMBER:
+            return "frame_start", (f"frame_start {msg.frame_start} is out of range (frame numbers end at "
+                                   f"{MAX_FRAME_NUMBER})")
+        return None
+
     def _handle_datagram(self, datagram: bytes) -> None:
         msg = ModemTransmission()
         try:
             msg.ParseFromString(datagram)
         except DecodeError as exc:
             self.malformed += 1
-            log.error("modem %d: dropping a datagram that is not a ModemTransmission (%d bytes): %s",
-                      self.modem_id, len(datagram), exc)
+            self.refuse("malformed", "not a ModemTransmission: %s", exc, size=len(datagram))
             return
         if msg.src == self.modem_id:
             return  # our own multicast loopback
+        bad = self.out_of_range(msg)
+        if bad is not None:
+            self.refuse(f"{bad[0]} out of range", "from modem %d: %s", msg.src, bad[1], size=len(datagram))
+            return
         self.received += 1
-        if (msg.type == ModemTransmission.DATA and msg.ack_requested and msg.dest == self.modem_id):
+        if (msg.type == ModemTransmission.DATA and msg.ack_requested and msg.dest == self.modem_id
+                and (self.peers is None or msg.src in self.peers)):
             ack = ModemTransmission(src=self.modem_id, dest=msg.src, type=ModemTransmission.ACK)
             ack.acked_frame.extend(range(msg.frame_start, msg.frame_start + len(msg.frame)))
             self._transmit(ack)

@@ -54,6 +54,7 @@ class EtherDriver(DatagramDriver):
         self._inbox = self.ether.attach(id(self))
 
     def shutdown(self) -> None:
+        self.refusals.flush(final=True)
         self.ether.detach(id(self))
         self._inbox = None
 

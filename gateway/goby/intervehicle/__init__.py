@@ -3,6 +3,7 @@ options, Subscription forwarding (DCCL id 3), and the links (DynamicBuffer, TDMA
 ``goby-broker``'s ``intervehicle {}`` block. See docs/intervehicle.md."""
 
 from gateway.goby.intervehicle.errors import (
+    IntervehicleConfigError,
     IntervehicleError,
     InvalidPublicationError,
     InvalidSubscriptionError,
@@ -14,6 +15,7 @@ from gateway.goby.intervehicle.protobuf.transporter_config_pb2 import Transporte
 __all__ = [
     "AckData",
     "ExpireData",
+    "IntervehicleConfigError",
     "IntervehicleError",
     "InvalidPublicationError",
     "InvalidSubscriptionError",

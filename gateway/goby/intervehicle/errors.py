@@ -15,3 +15,7 @@ class InvalidPublicationError(IntervehicleError, ValueError):
 
 class InvalidSubscriptionError(IntervehicleError, ValueError):
     """A subscription Goby refuses (no group function for a non-broadcast group, broadcast with ack_required)."""
+
+
+class IntervehicleConfigError(IntervehicleError, ValueError):
+    """A broker's intervehicle settings that cannot be used (names the field and the cause)."""

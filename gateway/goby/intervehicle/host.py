@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from gateway.goby.intervehicle.errors import IntervehicleConfigError
 from gateway.goby.intervehicle.portal import IntervehiclePortal
 from gateway.goby.portal.context import ProcessContext
 from gateway.goby.portal.runner import apply_simulation_time
@@ -30,7 +31,10 @@ def start_intervehicle(cfg: Any, manager_port: int) -> HostedIntervehicle:
     if ipc.transport == InterProcessPortalConfig.TCP and manager_port:
         ipc.tcp_port = manager_port
     clock = SystemClock()
-    apply_simulation_time(cfg, clock)
+    try:
+        apply_simulation_time(cfg, clock)
+    except ValueError as exc:  # e.g. warp_factor: -3 (the links run on the warped clock)
+        raise IntervehicleConfigError(f"app.simulation.time: {exc}") from None
     context = ProcessContext(ipc, application=(cfg.app.name or "goby-broker") + "/intervehicle", clock=clock)
     portal = IntervehiclePortal(cfg.intervehicle, context)
     try:

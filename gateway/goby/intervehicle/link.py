@@ -13,6 +13,11 @@ thread that calls ``loop`` (the link's thread).
 - The MAC starts our slots; ``_data_request`` fills one frame per slot (first winner fixes the destination, plain
   concatenation of DCCL messages, never above ``max_frame_bytes``); acks erase values, unacked ones are resent after
   ``ack_timeout``; received frames are split into DCCL packets (an unknown id drops the rest of the frame, logged).
+- Peers: the modems with a slot in the MAC plan. Data and acks from any other modem are dropped; the driver is
+  told them (and the most frames a slot carries) so it acks only peers and refuses oversized transmissions.
+  Drops caused by what arrives are counted and logged at a rate-limited cadence (``util.ratelimit``).
+- ``take_over(old)``: a restarted link (new thread, driver and MAC) keeps the queues, subscriptions and loaded
+  types of the one that failed.
 """
 
 from __future__ import annotations
@@ -44,8 +49,14 @@ from gateway.goby.intervehicle.protobuf.intervehicle_transporter_config_pb2 impo
 from gateway.goby.intervehicle.protobuf.serializer_transporter_pb2 import SerializerTransporterMessage
 from gateway.goby.intervehicle.serialization import message_class
 from gateway.goby.portal.marshalling import Scheme
+from util.ratelimit import RateLimitedLog
 
 log = logging.getLogger(__name__)
+
+#: Seconds between two log lines of the same kind of dropped frame (the first is logged at once).
+DROP_LOG_PERIOD_S = 10.0
+#: Full modem ids travel as int32 (``header.src``); an id past this cannot be a modem of ours.
+MAX_MODEM_ID = 2**31 - 1
 
 LinkConfig = PortalConfig.LinkConfig
 BufferId = str
@@ -94,6 +105,7 @@ class LinkCounters:
     expired_ttl: int = 0
     expired_overflow: int = 0
     dropped_frames: int = 0  # received frames (or their rest) dropped: unknown id, bad bytes, unknown modem
+    dropped_acks: int = 0  # acks from a modem that is not a peer
     unexpected_acks: int = 0
     max_frame_seen: int = 0  # largest data frame we sent
     slot_starts: list[float] = field(default_factory=list)  # warped start time of each of our transmissions
@@ -122,6 +134,10 @@ class Link:
         self._forwarded: dict[tuple[int, int, bytes, tuple[int, ...]], int] = {}
         self._pending_ack: dict[int, list[tuple[int, BufferId, Value]]] = {}
         self._slot_srcs = {slot.src for slot in cfg.mac.slot}
+        self.drops = RateLimitedLog(log, DROP_LOG_PERIOD_S)
+        peers = {self.within_subnet(src) for src in self._slot_srcs if self.in_subnet(src) and src != self.modem_id}
+        driver.expect(self.name, sorted(peers) if self._slot_srcs else None,
+                      max((slot.max_num_frames for slot in cfg.mac.slot), default=1))
         mac_cfg = type(cfg.mac)()
         mac_cfg.CopyFrom(cfg.mac)
         mac_cfg.modem_id = cfg.modem_id
@@ -140,6 +156,23 @@ class Link:
     def full_id(self, wire_id: int) -> int:
         return wire_id + self.broadcast_id
 
+    def is_peer(self, full_id: int) -> bool:
+        """A modem we take data and acks from: one with a slot in the MAC plan (any in the subnet if none)."""
+        if self._slot_srcs:
+            return full_id in self._slot_srcs
+        return 0 <= full_id <= MAX_MODEM_ID and self.in_subnet(full_id)
+
+    def take_over(self, old: Link) -> None:
+        """Carry on from ``old`` (a failed link): its queues, subscriptions, loaded types and counters. Values that
+        awaited an ack are sent again after ``ack_timeout`` (the new driver numbers frames afresh)."""
+        self.codec = old.codec
+        self.buffer = old.buffer
+        self.counters = old.counters
+        self._publisher_cfgs = old._publisher_cfgs
+        self._subscriber_cfgs = old._subscriber_cfgs
+        self._subscriptions = old._subscriptions
+        self._forwarded = old._forwarded
+
     # ------------------------------------------------------------------------------------- lifecycle
     def start(self) -> None:
         driver_cfg = type(self.cfg.driver)()
@@ -151,6 +184,7 @@ class Link:
     def stop(self) -> None:
         if self._started:
             self._started = False
+            self.drops.flush(final=True)
             self.driver.shutdown()
 
     def loop(self) -> None:
@@ -161,6 +195,7 @@ class Link:
             self._expire(value, dest, ExpireData.EXPIRED_TIME_TO_LIVE_EXCEEDED, now)
         self.driver.do_work()
         self.mac.do_work(now)
+        self.drops.flush()
 
     def _initiate(self, slot: ModemTransmission) -> None:
         self.counters.slot_starts.append(slot.time / 1e6)
@@ -335,17 +370,25 @@ class Link:
         full_src = self.full_id(msg.src)
         full_dest = self.full_id(msg.dest)
         if msg.type == ModemTransmission.ACK:
-            if full_dest == self.modem_id:
-                self._handle_ack(msg, full_src)
+            if full_dest != self.modem_id:
+                return
+            if not self.is_peer(full_src):
+                self.counters.dropped_acks += 1
+                self.drops.error("ack from unknown modem", "%s: dropping an ack from unknown modem %d (wire id %d): "
+                                 "it has no slot in the MAC plan [%d so far]", self.name, full_src, msg.src,
+                                 self.counters.dropped_acks)
+                return
+            self._handle_ack(msg, full_src)
             return
         if msg.type != ModemTransmission.DATA:
             return
         if full_dest not in (self.broadcast_id, self.modem_id):
             return
-        if self._slot_srcs and full_src not in self._slot_srcs:
+        if not self.is_peer(full_src):
             self.counters.dropped_frames += 1
-            log.error("%s: dropping a frame from unknown modem %d (wire id %d): it has no slot in the MAC plan",
-                      self.name, full_src, msg.src)
+            self.drops.error("unknown modem", "%s: dropping a frame from unknown modem %d (wire id %d): it has no "
+                             "slot in the MAC plan [%d frames dropped so far]", self.name, full_src, msg.src,
+                             self.counters.dropped_frames)
             return
         forwarded = DCCLForwardedData()
         forwarded.header.src = full_src
@@ -360,7 +403,8 @@ class Link:
                 try:
                     sub = self.codec.decode(packet.data, Subscription)
                 except DcclError as exc:
-                    log.error("%s: bad Subscription from modem %d: %s", self.name, full_src, exc)
+                    self.drops.error("bad subscription", "%s: bad Subscription from modem %d: %s", self.name,
+                                     full_src, exc)
                     continue
                 self.out.subscription_rx(sub)
 
@@ -372,10 +416,10 @@ class Link:
                 dccl_id = decode_id(frame, pos)[0]
                 _, rest = self.codec.decode_prefix(frame[pos:])
             except UnknownIdError as exc:
-                self._drop(frame, pos, full_src, f"DCCL id {exc.dccl_id} is not loaded here")
+                self._drop(frame, pos, full_src, "unknown id", f"DCCL id {exc.dccl_id} is not loaded here")
                 return
             except DcclError as exc:
-                self._drop(frame, pos, full_src, f"cannot decode: {exc}")
+                self._drop(frame, pos, full_src, "cannot decode", f"cannot decode: {exc}")
                 return
             end = len(frame) - len(rest)
             packet = out.frame.add()
@@ -383,10 +427,11 @@ class Link:
             packet.data = frame[pos:end]
             pos = end
 
-    def _drop(self, frame: bytes, pos: int, full_src: int, why: str) -> None:
+    def _drop(self, frame: bytes, pos: int, full_src: int, kind: str, why: str) -> None:
         self.counters.dropped_frames += 1
-        log.error("%s: frame from modem %d: %s; dropping the rest of the frame (%d of %d bytes, from byte %d)",
-                  self.name, full_src, why, len(frame) - pos, len(frame), pos)
+        self.drops.error(kind, "%s: frame from modem %d: %s; dropping the rest of the frame (%d of %d bytes, from "
+                         "byte %d) [%d frames dropped so far]", self.name, full_src, why, len(frame) - pos,
+                         len(frame), pos, self.counters.dropped_frames)
 
     def _handle_ack(self, msg: ModemTransmission, full_src: int) -> None:
         now = self.now()
@@ -394,8 +439,8 @@ class Link:
             entries = self._pending_ack.pop(frame_number, None)
             if entries is None:
                 self.counters.unexpected_acks += 1
-                log.warning("%s: ack from modem %d for frame %d that we are not waiting for; ignored", self.name,
-                            full_src, frame_number)
+                self.drops.warning("unexpected ack", "%s: ack from modem %d for frame %d that we are not waiting "
+                                   "for; ignored", self.name, full_src, frame_number)
                 continue
             for dest, bid, value in entries:
                 if not self.buffer.erase(dest, bid, value):

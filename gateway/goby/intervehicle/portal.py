@@ -5,6 +5,10 @@ Each :class:`LinkThread` subscribes to the application side's groups (``modem_da
 ``modem_subscription_forward_tx``/``_rx``) and publishes what its :class:`~gateway.goby.intervehicle.link.Link`
 reports (``modem_data_in``, ``modem_ack_in``, ``modem_expire_in``, ``subscription_report``). Received
 Subscriptions go out on ``modem_subscription_forward_rx`` so every link thread sees them, as in Goby.
+
+A link whose thread fails (any exception out of its loop) is reported (ERROR naming the link) and restarted on the
+same Python thread after a back-off, with a new driver, MAC and portal sockets but the old link's queues and
+subscriptions (``Link.take_over``); it never runs on silently without it (Goby's gobyd would end).
 """
 
 from __future__ import annotations
@@ -13,6 +17,7 @@ import logging
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from gateway.goby.acomms.driver import ModemDriver
 from gateway.goby.acomms.errors import AcommsError, ModemConfigError
@@ -44,6 +49,10 @@ LINK_LOOP_HZ = 10.0
 MAX_REAL_LOOP_HZ = 50.0
 #: Real seconds after start at which a link announces itself again (apps then resend their subscriptions).
 ANNOUNCE_AGAIN_S = (0.0, 2.0)
+#: Real seconds before a failed link is restarted: the n-th failure in a row waits the n-th (then the last) value.
+RESTART_BACKOFF_S = (0.5, 2.0, 5.0, 15.0, 30.0)
+#: A link that ran this long (real seconds) since its last restart starts the back-off afresh when it fails.
+RESTART_RESET_S = 60.0
 
 
 def make_driver(cfg: DriverConfig, ethers: dict[str, Ether] | None = None) -> ModemDriver:
@@ -66,7 +75,7 @@ def make_driver(cfg: DriverConfig, ethers: dict[str, Ether] | None = None) -> Mo
 class LinkThread(SimpleThread):
     """One link's loop (10 Hz warped) and its interprocess plumbing."""
 
-    def __init__(self, cfg: LinkConfig, driver: ModemDriver) -> None:
+    def __init__(self, cfg: LinkConfig, driver: ModemDriver, previous: Link | None = None) -> None:
         # Goby's 10 Hz warped is 300 Hz real at warp 30: cap it (a slot then starts at most 1/MAX_REAL_LOOP_HZ late)
         context = current_context()
         warp = context.clock.effective_warp if context is not None else 1
@@ -85,6 +94,8 @@ class LinkThread(SimpleThread):
         # tens of real milliseconds, so we also allow half a real second (docs/intervehicle.md).
         skew = max(ALLOWED_SKEW_S, REAL_SKEW_S * self.context.clock.effective_warp)
         self.link = Link(cfg, driver, self.context.clock.now, outputs, allowed_skew_s=skew)
+        if previous is not None:
+            self.link.take_over(previous)
         ip.subscribe(groups.modem_data_out, SerializerTransporterMessage, self.link.buffer_message)
         ip.subscribe(groups.modem_subscription_forward_tx, Subscription, self.link.forward_subscription)
         ip.subscribe(groups.modem_subscription_forward_rx, Subscription, self.link.accept_subscription)
@@ -124,21 +135,39 @@ class LinkThread(SimpleThread):
         self.link.stop()
 
 
+@dataclass
+class RunningLink:
+    """A link and the Python thread that runs it (``thread`` is replaced when the link restarts)."""
+
+    cfg: LinkConfig
+    thread: LinkThread
+    pythread: threading.Thread | None = None
+    failures: int = 0  # thread failures since the portal started
+    restarts: int = 0
+
+
 class IntervehiclePortal:
     """Runs the links of a ``PortalConfig`` in ``context`` (the broker's); ``start()`` returns once every link's
-    driver started (raises ``AcommsError`` naming the link otherwise); ``stop()`` is idempotent."""
+    driver started (raises ``AcommsError`` naming the link otherwise); ``stop()`` is idempotent. A link whose
+    thread fails is reported and restarted (see the module docstring)."""
 
     def __init__(self, cfg: PortalConfig, context: ProcessContext, ethers: dict[str, Ether] | None = None,
                  driver_factory: Callable[[DriverConfig], ModemDriver] | None = None) -> None:
         self.cfg = cfg
         self.context = context
         self._factory = driver_factory or (lambda c: make_driver(c, ethers))
-        self._threads: list[tuple[LinkThread, threading.Thread]] = []
+        self._running: list[RunningLink] = []
+        self._lock = threading.Lock()  # guards RunningLink.thread against stop() during a restart
+        self._stopping = threading.Event()
         self._stopped = False
 
     @property
     def links(self) -> list[Link]:
-        return [t.link for t, _ in self._threads]
+        return [r.thread.link for r in self._running]
+
+    @property
+    def running(self) -> list[RunningLink]:
+        return list(self._running)
 
     def start(self) -> IntervehiclePortal:
         self.context.release_hold()  # the portal serves others; it never waits for required clients
@@ -150,41 +179,96 @@ class IntervehiclePortal:
             raise
         return self
 
+    def _build(self, cfg: LinkConfig, previous: Link | None = None) -> LinkThread:
+        """A started link thread object (its driver up), built on the calling thread."""
+        thread = LinkThread(cfg, self._factory(cfg.driver), previous)
+        try:
+            thread.initialize()
+        except BaseException:
+            thread.close()
+            raise
+        return thread
+
     def _start_link(self, cfg: LinkConfig) -> None:
-        driver = self._factory(cfg.driver)
+        def build() -> RunningLink:
+            return RunningLink(cfg, self._build(cfg))
 
-        def build() -> LinkThread:
-            thread = LinkThread(cfg, driver)
-            try:
-                thread.initialize()
-            except BaseException:
-                thread.close()
-                raise
-            return thread
+        try:
+            running, pythread = start_on_thread(self.context, build, self._supervise,
+                                                f"intervehicle-link-{cfg.modem_id}")
+        except BaseException as exc:  # reported to start()
+            raise AcommsError(f"intervehicle link {cfg.modem_id}: {exc}") from exc
+        running.pythread = pythread
+        self._running.append(running)
+        log.info("intervehicle link %d up (subnet mask 0x%X, %d slot(s))", cfg.modem_id, cfg.subnet_mask,
+                 len(cfg.mac.slot))
 
-        def run(thread: LinkThread) -> None:
+    def _supervise(self, running: RunningLink) -> None:
+        """Run the link until the portal stops; report and restart it whenever its thread fails."""
+        while True:
+            thread = running.thread
+            started = time.monotonic()
             try:
                 while thread.alive:
                     thread.run_once()
-            except Exception:
-                log.exception("link %d failed", cfg.modem_id)
-            finally:
-                thread.finalize()
-                thread.close()
+            except Exception as exc:  # noqa: BLE001 - any failure: reported, then the link is restarted
+                running.failures += 1
+                failed: BaseException | None = exc
+            else:
+                failed = None
+            self._close_thread(running)
+            if failed is None or self._stopping.is_set():
+                return
+            if time.monotonic() - started > RESTART_RESET_S:
+                running.restarts = 0
+            while not self._restart(running, failed):
+                failed = None  # the restart itself failed (logged); try again after the next back-off
 
+    def _restart(self, running: RunningLink, failed: BaseException | None) -> bool:
+        """Wait the back-off, then build the link again; True once it runs again or the portal is stopping."""
+        delay = RESTART_BACKOFF_S[min(running.restarts, len(RESTART_BACKOFF_S) - 1)]
+        if failed is not None:
+            log.error("intervehicle link %d failed (%s: %s); restarting it in %g s (failure %d)",
+                      running.cfg.modem_id, type(failed).__name__, failed, delay, running.failures)
+            log.debug("intervehicle link %d failure", running.cfg.modem_id, exc_info=failed)
+        if self._stopping.wait(delay):
+            return True
+        running.restarts += 1
         try:
-            started = start_on_thread(self.context, build, run, f"intervehicle-link-{cfg.modem_id}")
-        except BaseException as exc:  # reported to start()
-            raise AcommsError(f"intervehicle link {cfg.modem_id}: {exc}") from exc
-        self._threads.append(started)
-        log.info("intervehicle link %d up (subnet mask 0x%X, %d slot(s))", cfg.modem_id, cfg.subnet_mask,
-                 len(cfg.mac.slot))
+            thread = self._build(running.cfg, running.thread.link)
+        except Exception as exc:  # noqa: BLE001 - e.g. the multicast group cannot be joined right now
+            log.error("intervehicle link %d: restart %d failed (%s: %s); trying again", running.cfg.modem_id,
+                      running.restarts, type(exc).__name__, exc)
+            return False
+        with self._lock:
+            running.thread = thread
+            if self._stopping.is_set():
+                thread.quit()
+        log.warning("intervehicle link %d restarted (restart %d); its queues and subscriptions were kept",
+                    running.cfg.modem_id, running.restarts)
+        return True
+
+    @staticmethod
+    def _close_thread(running: RunningLink) -> None:
+        """Stop the link's driver and close its sockets; a failure here is logged, never raised."""
+        thread = running.thread
+        try:
+            thread.finalize()
+        except Exception as exc:  # noqa: BLE001
+            log.error("intervehicle link %d: stopping its driver failed: %s", running.cfg.modem_id, exc)
+        try:
+            thread.close()
+        except Exception as exc:  # noqa: BLE001
+            log.error("intervehicle link %d: closing its sockets failed: %s", running.cfg.modem_id, exc)
 
     def stop(self) -> None:
         if self._stopped:
             return
         self._stopped = True
-        for thread, _ in self._threads:
-            thread.quit()
-        for _, pythread in self._threads:
-            pythread.join(10)
+        self._stopping.set()
+        with self._lock:
+            for running in self._running:
+                running.thread.quit()
+        for running in self._running:
+            if running.pythread is not None:
+                running.pythread.join(10)

@@ -2,11 +2,13 @@
 runs the start-up hold.
 
 Two threads: the proxy (``zmq.proxy_steerable``, stopped through an inproc control socket) and the manager
-(REP for endpoint requests, SUB/PUB on the proxy for hold-state requests).  Neither thread runs user code.
+(REP for endpoint requests, SUB/PUB on the proxy for hold-state requests, and the admission control of
+``broker_admission``: ZAP answers and connection counts).  Neither thread runs user code.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 import socket
@@ -16,6 +18,7 @@ from typing import Any
 import zmq
 
 from gateway.errors import GatewayError
+from gateway.goby.portal.broker_admission import AdmissionControl, BrokerLimits
 from gateway.goby.portal.endpoints import (
     MANAGER_REQUEST_GROUP,
     MANAGER_RESPONSE_GROUP,
@@ -43,7 +46,7 @@ log = logging.getLogger(__name__)
 READY_PREFIX = "goby-broker ready: "  # goby-broker's stdout line when serving, then JSON endpoints
 
 
-MAX_MESSAGE_BYTES = 64 * 1024 * 1024
+MAX_MESSAGE_BYTES = BrokerLimits.max_message_bytes  # one publication frame (ZeroMQ's MAXMSGSIZE on the XSUB)
 
 
 class BrokerError(PortalError):
@@ -68,10 +71,18 @@ def _ipc_in_use(path: str) -> bool:
 class Broker:
     """Router + manager for one platform.  ``start()`` binds and returns when ready; ``stop()`` is idempotent."""
 
-    def __init__(self, cfg: GobyDaemonConfig | None = None, max_message_bytes: int = MAX_MESSAGE_BYTES) -> None:
+    def __init__(self, cfg: GobyDaemonConfig | None = None, max_message_bytes: int | None = None,
+                 limits: BrokerLimits | None = None) -> None:
+        """``limits`` bound every input (frames, connections, handshake and heartbeat times); ``max_message_bytes``
+        overrides its publication frame limit.  GobyDaemonConfig keeps Goby's field set, so these are arguments."""
         self.cfg = cfg if cfg is not None else GobyDaemonConfig()
+        limits = limits or BrokerLimits()
+        if max_message_bytes is not None:
+            limits = dataclasses.replace(limits, max_message_bytes=int(max_message_bytes))
+        self.limits = limits
         # ZeroMQ would allocate whatever a frame header announces; past this the sender is disconnected instead.
-        self.max_message_bytes = int(max_message_bytes)
+        self.max_message_bytes = limits.max_message_bytes
+        self._admission: AdmissionControl | None = None  # handed to the manager thread, which closes it
         self.ipc: InterProcessPortalConfig = self.cfg.interprocess
         self.required_clients = frozenset(self.cfg.hold.required_client)
         self.reported_clients: set[str] = set()
@@ -116,6 +127,7 @@ class Broker:
         self._started = True
         self._zctx = zmq.Context(io_threads=max(1, self.cfg.router_threads))
         self._mctx = zmq.Context(io_threads=1)
+        self._admission = admission = AdmissionControl(self.limits)
         xpub = self._zctx.socket(zmq.XPUB)
         xsub = self._zctx.socket(zmq.XSUB)
         for sock in (xpub, xsub):
@@ -123,7 +135,9 @@ class Broker:
             sock.setsockopt(zmq.RCVHWM, self.ipc.receive_queue_size)
             sock.setsockopt(zmq.IPV6, 1)
             sock.setsockopt(zmq.LINGER, 0)
-            sock.setsockopt(zmq.MAXMSGSIZE, self.max_message_bytes)
+        # subscribers send only subscriptions (small frames); publishers send the publications
+        admission.guard(self._zctx, xpub, "xpub", self.limits.max_control_bytes)
+        admission.guard(self._zctx, xsub, "xsub", self.limits.max_message_bytes)
         try:
             if self.is_tcp:  # the configured address only (Goby's ipv4_address, default 127.0.0.1)
                 self.pub_port = xpub.bind_to_random_port(self._tcp_host())
@@ -144,8 +158,8 @@ class Broker:
 
         rep = self._mctx.socket(zmq.REP)
         rep.setsockopt(zmq.LINGER, 0)
-        rep.setsockopt(zmq.MAXMSGSIZE, self.max_message_bytes)
         rep.setsockopt(zmq.IPV6, 1)
+        admission.guard(self._mctx, rep, "manager", self.limits.max_control_bytes)
         try:
             endpoint = manager_endpoint(self.ipc)
             if self.is_tcp and self.ipc.tcp_port == 0:
@@ -159,8 +173,9 @@ class Broker:
             rep.close()
             self.stop()
             raise BrokerError(f"cannot bind the manager socket {manager_endpoint(self.ipc)}: {exc}") from exc
-        self._manager_stop = self._start_thread(self._mctx, "broker-manager-stop", self._run_manager, (rep,),
-                                                "broker-manager")
+        self._admission = None  # the manager thread owns and closes it from here on
+        self._manager_stop = self._start_thread(self._mctx, "broker-manager-stop", self._run_manager,
+                                                (rep, admission), "broker-manager")
         if not self._ready.wait(10):
             self.stop()
             raise BrokerError("the broker's manager thread did not become ready within 10 s")
@@ -213,6 +228,8 @@ class Broker:
         for sock in (self._proxy_control, self._manager_stop):
             if sock is not None:
                 sock.close(linger=0)
+        if self._admission is not None:  # start() failed before the manager thread took it over
+            self._admission.close()
         for zctx in (self._zctx, self._mctx):
             if zctx is not None:
                 zctx.term()
@@ -241,7 +258,7 @@ class Broker:
             for sock in (xpub, xsub, control):
                 sock.close(linger=0)
 
-    def _run_manager(self, rep: zmq.Socket, stop: zmq.Socket) -> None:
+    def _run_manager(self, rep: zmq.Socket, admission: AdmissionControl, stop: zmq.Socket) -> None:
         endpoints = self.endpoints()
         sub = self._mctx.socket(zmq.SUB)
         pub = self._mctx.socket(zmq.PUB)
@@ -255,7 +272,8 @@ class Broker:
         response_ident = make_identifier(
             MANAGER_RESPONSE_GROUP, Scheme.PROTOBUF, ManagerResponse.DESCRIPTOR.full_name, os.getpid(), thread_id())
         poller = zmq.Poller()
-        for sock in (rep, sub, stop):
+        guards = admission.sockets()
+        for sock in (rep, sub, stop, *guards):
             poller.register(sock, zmq.POLLIN)
         self._ready.set()
         try:
@@ -269,11 +287,15 @@ class Broker:
                     reply = self._answer_hold(sub.recv())
                     if reply is not None:
                         pub.send(encode_frame(response_ident, reply.SerializeToString()))
+                for sock in guards:
+                    if sock in ready:
+                        admission.handle(sock)
         except zmq.ContextTerminated:
             pass
         finally:
             for sock in (rep, sub, pub, stop):
                 sock.close(linger=0)
+            admission.close()
 
     # ------------------------------------------------------------------------------------------ answers
     def _answer_rep(self, raw: bytes) -> bytes:

@@ -8,6 +8,7 @@ the command line set the ``interprocess`` block), as Goby's configurator does.
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from dataclasses import dataclass
@@ -138,9 +139,13 @@ def load_config(
     path = args.cfg_path or args.config_file
     if path:
         try:
-            text = Path(path).read_text()
+            text = Path(path).read_text(encoding="utf-8")
         except OSError as exc:
             raise AppConfigError(f"cannot read configuration file {path}: {exc.strerror}") from None
+        except UnicodeDecodeError as exc:  # a binary file: say so instead of a traceback
+            line = exc.object[:exc.start].count(b"\n") + 1
+            raise AppConfigError(f"configuration file {path}: line {line}: not protobuf text format "
+                                 f"(byte 0x{exc.object[exc.start]:02x} at offset {exc.start} is not UTF-8)") from None
         _merge_text(cfg, text, f"configuration file {path}")
     for field in config_type.DESCRIPTOR.fields:
         for value in getattr(args, f"field_{field.name}", None) or ():
@@ -170,6 +175,7 @@ def load_config(
     if not cfg.IsInitialized():
         missing = ", ".join(cfg.FindInitializationErrors())
         raise AppConfigError(f"configuration is missing required field(s): {missing}")
+    check_values(cfg)
     verbosity = args.verbose
     debug_cfg = False
     if "app" in fields:
@@ -177,6 +183,31 @@ def load_config(
             verbosity = max(verbosity, _TTY_VERBOSITY.get(cfg.app.glog_config.tty_verbosity, 0))
         debug_cfg = cfg.app.debug_cfg
     return LoadedConfig(cfg, verbosity, False, debug_cfg)
+
+
+_INTEGER_TYPES = {_FD.TYPE_INT32, _FD.TYPE_INT64, _FD.TYPE_UINT32, _FD.TYPE_UINT64, _FD.TYPE_SINT32,
+                  _FD.TYPE_SINT64, _FD.TYPE_FIXED32, _FD.TYPE_FIXED64, _FD.TYPE_SFIXED32, _FD.TYPE_SFIXED64}
+
+
+def check_values(cfg: pb_message.Message, where: str = "") -> None:
+    """Refuse values the types allow but nothing can use, naming the field: a port outside 0..65535 (a uint32
+    that the socket layer would silently wrap: 99999 listens on 34463) and a ``warp_factor`` that is not > 0."""
+    for field, value in cfg.ListFields():
+        name = f"[{field.full_name}]" if field.is_extension else field.name
+        path = f"{where}.{name}" if where else name
+        values = value if _is_repeated(field) else [value]
+        if field.type == _FD.TYPE_MESSAGE:
+            for i, sub in enumerate(values):
+                check_values(sub, f"{path}[{i}]" if _is_repeated(field) else path)
+            continue
+        if field.type not in _INTEGER_TYPES and field.type not in (_FD.TYPE_DOUBLE, _FD.TYPE_FLOAT):
+            continue
+        for number in values:
+            if (field.name == "port" or field.name.endswith("_port")) and field.type in _INTEGER_TYPES:
+                if not 0 <= number <= 65535:
+                    raise AppConfigError(f"{path}: {number} is not a port number (0..65535)")
+            if field.name == "warp_factor" and not (math.isfinite(number) and number > 0):
+                raise AppConfigError(f"{path}: {number} must be a finite number > 0")
 
 
 def _is_repeated(field: pb_descriptor.FieldDescriptor) -> bool:

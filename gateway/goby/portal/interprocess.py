@@ -5,6 +5,16 @@ XPUB); callbacks run on that thread inside its poll.  The first portal in a proc
 thread) runs Goby's hold handshake with the manager; until the hold is released every thread buffers its
 publications.  A publication is also handed to interthread subscribers of the same group and type in this
 process, as Goby's ``publish`` does.
+
+Restarts (docs/portal.md "Broker restart"): the publishing socket is an XPUB, so it reads the subscriptions the
+broker forwards to it and knows which of its publications have a subscriber.  After a reconnection a publication
+whose subscription has not come back yet is refused (``publish`` returns False, counted); while connected, a small
+probe that this thread publishes to itself through the broker confirms what went before it, and what is
+unconfirmed when the connection drops is reported (``on_undelivered``).  This module is the socket layer: what the
+XPUB has seen is kept by ``subscription_evidence``, what is unconfirmed by ``delivery_ledger``, and received frames
+go to the subscribers through ``frame_dispatch``; the primary's hold requests come from ``hold_handshake`` (none
+of these four holds a socket); a TCP portal asks the manager for moved ports through ``endpoint_requery``.  All of
+it runs on the owning thread.
 """
 
 from __future__ import annotations
@@ -16,24 +26,18 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
 from typing import Any
 
 import zmq
 
 from gateway.goby.portal.context import ProcessContext
-from gateway.goby.portal.endpoints import MANAGER_REQUEST_GROUP, MANAGER_RESPONSE_GROUP
-from gateway.goby.portal.errors import ClosedError, IdentifierError, MarshallingError, WrongThreadError
+from gateway.goby.portal.delivery_ledger import MAX_UNCONFIRMED, DeliveryLedger
+from gateway.goby.portal.endpoint_requery import EndpointRequery
+from gateway.goby.portal.errors import ClosedError, WrongThreadError
+from gateway.goby.portal.frame_dispatch import FrameDispatcher, RegexCallback, RegexSubscription, Subscription
 from gateway.goby.portal.group import GroupLike, as_group, check_named
-from gateway.goby.portal.identifier import (
-    EVERYTHING,
-    Identifier,
-    decode_frame,
-    encode_frame,
-    make_identifier,
-    thread_id,
-    type_prefix,
-)
+from gateway.goby.portal.hold_handshake import HoldHandshake
+from gateway.goby.portal.identifier import EVERYTHING, encode_frame, make_identifier, thread_id, type_prefix
 from gateway.goby.portal.interface_registry import InterfaceEntry
 from gateway.goby.portal.interthread import type_key
 from gateway.goby.portal.mailbox import Mailbox
@@ -41,43 +45,21 @@ from gateway.goby.portal.manager_client import request_endpoints
 from gateway.goby.portal.marshalling import (
     Scheme,
     interprocess_scheme,
-    parse,
     scheme_to_string,
     serialize,
     type_name,
 )
+from gateway.goby.portal.subscription_evidence import LIVE, MISSING, RESUBSCRIBE_WAIT_S, SubscriptionEvidence
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
-from gateway.goby.protobuf.interprocess_zeromq_pb2 import PROVIDE_HOLD_STATE, ManagerRequest, ManagerResponse
+from gateway.goby.protobuf.interprocess_zeromq_pb2 import ManagerResponse
 
 log = logging.getLogger(__name__)
 
 LAYER = "interprocess"
-HOLD_REQUEST_PERIOD_S = 0.1
 #: How long ``publish`` waits for room when the PUB queue toward the broker is full before dropping (logged).
 SEND_BLOCK_S = 1.0
-IN_DOUBT_S = 0.5  # publications this recent when the broker connection drops may have died with it
-RESUBSCRIBE_SETTLE_S = 0.5  # after a reconnection, time for the subscribers' subscriptions to reach our PUB
+PROBE_GROUP = "goby::zeromq::_internal_delivery_probe"  # not in Goby3: each portal publishes it to itself
 RECV_BATCH = 512
-HEAD_CACHE_SIZE = 4096  # distinct identifiers remembered as already validated
-
-RegexCallback = Callable[[bytes, int, str, str], None]
-
-
-@dataclass(eq=False)
-class _Subscription:
-    msg_type: type
-    scheme: int
-    callback: Callable[[Any], None]
-    echo: bool
-    group: str
-
-
-@dataclass(eq=False)
-class _RegexSubscription:
-    callback: RegexCallback
-    group_re: re.Pattern[str]
-    type_re: re.Pattern[str]
-    schemes: frozenset[int]
 
 
 class InterProcessPortal:
@@ -91,44 +73,48 @@ class InterProcessPortal:
         self._pid = os.getpid()
         self._thread_hex = thread_id()
         self._owner = threading.get_ident()
-        self._subs: dict[bytes, list[_Subscription]] = {}
-        self._regex: list[_RegexSubscription] = []
+        self._frames = FrameDispatcher(thread_name, self._pid, context.dccl, log)
+        self._subs = self._frames.subs
+        self._regex = self._frames.regex
         self._held: deque[bytes] = deque()
         self._identifiers: dict[tuple[str, int, str], str] = {}
         self._groups: dict[GroupLike, str] = {}
         self._types: dict[tuple[type, int | None], tuple[int, str, str]] = {}
-        self._heads: dict[bytes, tuple[Identifier, bytes]] = {}
         self._closed = False
         self.dropped = 0
-        self.malformed = 0
-        self.refused = 0  # publications refused because the broker connection was down (publish returned False)
-        self.in_doubt = 0  # publications reported undelivered: sent just before the connection dropped
+        self.refused = 0  # publications refused: no connection, or their subscription not back yet (returned False)
+        self.in_doubt = 0  # publications reported undelivered: not confirmed by a probe when the connection dropped
         self.on_undelivered: Callable[[list[tuple[str, bytes]]], None] | None = None
-        self._recent: deque[tuple[float, str, bytes]] = deque()  # (sent at, group, payload), the last IN_DOUBT_S
-        self._settle_until = 0.0
+        self._topics = SubscriptionEvidence()  # what our XPUB knows: publications are classified against it
+        self._ledger = DeliveryLedger()  # publications sent to a live topic and not yet confirmed by a probe
         zctx = context.zmq_context
         self._pub_endpoint, self._sub_endpoint, _ = request_endpoints(zctx, self._cfg, context.client_name)
-        self._pub = zctx.socket(zmq.PUB)
+        self._pub = zctx.socket(zmq.XPUB)  # a PUB that also hands us the subscriptions it receives
         self._sub = zctx.socket(zmq.SUB)
         for sock in (self._pub, self._sub):
             sock.setsockopt(zmq.SNDHWM, self._cfg.send_queue_size)
             sock.setsockopt(zmq.RCVHWM, self._cfg.receive_queue_size)
             sock.setsockopt(zmq.IPV6, 1)
         self._pub.setsockopt(zmq.XPUB_NODROP, 1)  # a full queue is reported to us instead of dropping silently
+        # No queue toward a broker that is not there: a new connection starts with no subscriptions, so what we
+        # learn from the new broker is all there is (a kept queue would keep the dead broker's subscriptions).
+        self._pub.setsockopt(zmq.IMMEDIATE, 1)
         self._pub.setsockopt(zmq.LINGER, 500)  # flush what was published just before exit
         self._sub.setsockopt(zmq.LINGER, 0)
-        self._monitor = self._sub.get_monitor_socket(zmq.EVENT_CONNECTED | zmq.EVENT_DISCONNECTED)
+        self._monitor = self._pub.get_monitor_socket(zmq.EVENT_CONNECTED | zmq.EVENT_DISCONNECTED)
         self._ever_connected = False
         self._disconnected = False
-        self._requery_at: float | None = None  # TCP: when to ask the manager for (possibly new) ports
+        self.on_pollable: Callable[[zmq.Socket, bool], None] | None = None  # the owner's poller: (socket, add?)
+        self._requery = EndpointRequery(zctx, self._cfg, context.client_name, thread_name, self._pollable_changed, log)
+        self._probe_ident = make_identifier(PROBE_GROUP, Scheme.CSTR, "CSTR", self._pid, self._thread_hex)
+        self._probe_head = self._probe_ident.encode()
+        self._probe_prefix = type_prefix(PROBE_GROUP, Scheme.CSTR, "CSTR").encode()
+        self._sub.setsockopt(zmq.SUBSCRIBE, self._probe_head)
         self._pub.connect(self._pub_endpoint)
         self._sub.connect(self._sub_endpoint)
         self._primary = context.claim_primary()
-        self._hold_response_prefix = type_prefix(
-            MANAGER_RESPONSE_GROUP, Scheme.PROTOBUF, ManagerResponse.DESCRIPTOR.full_name
-        ).encode()
-        self._next_hold_request = 0.0
-        self._release_at: float | None = None
+        self._hold = HoldHandshake(context.client_name, self._pid, self._thread_hex, context.hold_settle_s)
+        self._hold_response_prefix = self._hold.response_prefix
         if self._primary and not context.hold_released:
             self._sub.setsockopt(zmq.SUBSCRIBE, self._hold_response_prefix)
         context.register_mailbox(mailbox)
@@ -188,20 +174,30 @@ class InterProcessPortal:
         if not self._ctx.hold_released:
             self._held.append(frame)
             return True
-        now = time.monotonic()
-        if self._disconnected or now < self._settle_until:
-            self.refused += 1
-            if self.refused == 1 or self.refused % 100 == 0:
-                log.error("%s: publication on %s refused: the broker connection is down (%d refused so far)",
-                          self._thread_name, group, self.refused)
+        kind = self._topics.classify(ident)
+        if self._disconnected or kind == MISSING:
+            self._refuse(group)
             return False
         if self._held:
             self._flush_held()
-        recent = self._recent
-        recent.append((now, group, payload))
-        while recent[0][0] < now - IN_DOUBT_S:
-            recent.popleft()
-        return self._send(frame)
+        sent = self._send(frame)
+        if sent and kind == LIVE:
+            now = time.monotonic()
+            ledger = self._ledger
+            if ledger.record(group, payload, now):
+                self._send_probe(now)
+            if ledger.assumed_delivered == 1:
+                log.warning("%s: over %d publications unconfirmed (no probe came back): the oldest are assumed "
+                            "delivered", self._thread_name, MAX_UNCONFIRMED)
+        return sent
+
+    def _refuse(self, group: str) -> None:
+        self.refused += 1
+        if self.refused == 1 or self.refused % 100 == 0:
+            why = ("the broker connection is down" if self._disconnected
+                   else "its subscriber has not subscribed again since the broker came back")
+            log.error("%s: publication on %s refused: %s (%d refused so far)",
+                      self._thread_name, group, why, self.refused)
 
     def _send(self, frame: bytes) -> bool:
         try:
@@ -255,7 +251,7 @@ class InterProcessPortal:
         if prefix not in self._subs:
             self._subs[prefix] = []
             self._sub.setsockopt(zmq.SUBSCRIBE, prefix)
-        self._subs[prefix].append(_Subscription(msg_type, sch, callback, echo, group_text))
+        self._subs[prefix].append(Subscription(msg_type, sch, callback, echo, group_text))
 
     def unsubscribe(self, group: GroupLike, msg_type: type, *, scheme: int | None = None) -> None:
         """Remove this thread's subscriptions to (group, msg_type)."""
@@ -290,7 +286,7 @@ class InterProcessPortal:
         self._record("subscribe", f"regex:{group_regex}", Scheme.ALL_SCHEMES, f"regex:{type_regex}")
         if not self._regex:
             self._sub.setsockopt(zmq.SUBSCRIBE, EVERYTHING)
-        self._regex.append(_RegexSubscription(callback, re.compile(group_regex), re.compile(type_regex), scheme_set))
+        self._regex.append(RegexSubscription(callback, re.compile(group_regex), re.compile(type_regex), scheme_set))
 
     def subscribe_type_regex(
         self, group: GroupLike, callback: RegexCallback, type_regex: str = ".*", scheme: int = Scheme.PROTOBUF
@@ -310,46 +306,92 @@ class InterProcessPortal:
 
     # ------------------------------------------------------------------------------ owner-thread plumbing
     def pollables(self) -> list[zmq.Socket]:
-        """Sockets the owning thread's poller must watch."""
-        return [self._sub, self._monitor]
+        """Sockets the owning thread's poller must watch (a manager query adds its own through ``on_pollable``)."""
+        sockets = [self._sub, self._pub, self._monitor]
+        if self._requery.socket is not None:
+            sockets.append(self._requery.socket)
+        return sockets
+
+    def _pollable_changed(self, sock: zmq.Socket, add: bool) -> None:
+        if self.on_pollable is not None:
+            self.on_pollable(sock, add)
 
     def handle(self, sock: zmq.Socket) -> int:
         """Process what is readable on ``sock``; returns the number of events handled."""
+        if sock is self._sub:
+            return self._receive()
+        if sock is self._pub:
+            # The monitor first: a dropped connection is announced there before ZeroMQ withdraws the dead
+            # broker's subscriptions from our XPUB, so those withdrawals are known to be the crash.
+            return self._handle_monitor() + self._read_subscriptions()
         if sock is self._monitor:
             return self._handle_monitor()
-        return self._receive()
+        if sock is self._requery.socket:
+            events, endpoints = self._requery.finish()
+            if endpoints is not None and endpoints != (self._pub_endpoint, self._sub_endpoint):
+                self._reconnect_to(*endpoints)
+            return events
+        return 0
+
+    def _read_subscriptions(self) -> int:
+        """The (un)subscriptions the broker forwarded to our XPUB: which topics have a subscriber."""
+        count = 0
+        while True:
+            try:
+                msg = self._pub.recv(zmq.NOBLOCK)
+            except zmq.Again:
+                break
+            count += 1
+            if self._topics.on_subscription_message(msg):
+                log.info("%s: every subscription seen before the broker restart is back", self._thread_name)
+        return count
 
     def service(self, now: float) -> int:
-        """Timed work: hold requests while holding (primary only), flushing buffered publications once released."""
+        """Timed work: hold requests while holding (primary only), flushing buffered publications once released,
+        delivery probes, giving up on subscriptions that did not come back, TCP manager queries."""
         events = 0
         if self._primary and not self._ctx.hold_released:
-            if self._release_at is not None:
-                if now >= self._release_at:
-                    self._sub.setsockopt(zmq.UNSUBSCRIBE, self._hold_response_prefix)
-                    log.info("%s: hold released by the manager", self._thread_name)
-                    self._ctx.release_hold()
-                    events += 1
-            elif now >= self._next_hold_request:
-                self._send_hold_request()
-                self._next_hold_request = now + HOLD_REQUEST_PERIOD_S
+            request = self._hold.request_due(now, self._ctx.ready_flag)
+            if request is not None:
+                try:
+                    self._pub.send(request, zmq.NOBLOCK)
+                except zmq.Again:
+                    log.debug("%s: hold request not sent (queue full); retrying", self._thread_name)
+            elif self._hold.released(now):
+                self._sub.setsockopt(zmq.UNSUBSCRIBE, self._hold_response_prefix)
+                log.info("%s: hold released by the manager", self._thread_name)
+                self._ctx.release_hold()
+                events += 1
         if self._held and self._ctx.hold_released:
             self._flush_held()
             events += 1
-        if self._requery_at is not None and now >= self._requery_at:
-            self._requery_endpoints(now)
+        if self._requery.due_at is not None and now >= self._requery.due_at:
+            self._requery.start(now)
+        if self._ledger.probe_due(now):
+            self._send_probe(now)
+        if not self._disconnected:
+            gone = self._topics.give_up(now)
+            if gone:
+                log.warning("%s: %d subscription(s) seen before the broker restart did not come back within %.1f s; "
+                            "publishing to them again as to any topic without subscribers: %s", self._thread_name,
+                            len(gone), RESUBSCRIBE_WAIT_S, [t.decode(errors="replace") for t in gone])
         return events
 
-    def _requery_endpoints(self, now: float) -> None:
-        """TCP after a broker restart: the pub/sub ports are ephemeral, so ask the manager where they are now."""
+    def _send_probe(self, now: float) -> None:
+        """Publish a probe to ourselves through the broker: when it comes back, everything sent before it has
+        passed the broker (one PUB → XSUB → XPUB path, in order)."""
+        if self._disconnected or self._topics.classify(self._probe_ident) != LIVE:
+            self._ledger.probe_not_sent(now)  # our own probe subscription is not through yet: try again later
+            return
         try:
-            pub, sub, _ = request_endpoints(self._ctx.zmq_context, self._cfg, self._ctx.client_name, timeout_s=0.3)
-        except Exception as exc:  # noqa: BLE001 - broker still down: try again later
-            log.debug("%s: manager not answering yet (%s)", self._thread_name, exc)
-            self._requery_at = now + 1.0
+            self._pub.send(encode_frame(self._probe_ident, self._ledger.next_probe()), zmq.NOBLOCK)
+        except zmq.Again:
+            self._ledger.probe_not_sent(now)
             return
-        self._requery_at = None
-        if (pub, sub) == (self._pub_endpoint, self._sub_endpoint):
-            return
+        self._ledger.probe_sent(now)
+
+    def _reconnect_to(self, pub: str, sub: str) -> None:
+        """Move both sockets to the endpoints the manager gave (ZeroMQ would retry the old ports forever)."""
         log.warning("%s: broker moved to publish %s / subscribe %s; reconnecting", self._thread_name, pub, sub)
         for sock, old, new in ((self._pub, self._pub_endpoint, pub), (self._sub, self._sub_endpoint, sub)):
             try:
@@ -361,24 +403,13 @@ class InterProcessPortal:
 
     def next_deadline(self) -> float | None:
         """The monotonic time ``service`` next needs to run, if any."""
-        deadline = self._requery_at
+        deadlines = [] if self._requery.due_at is None else [self._requery.due_at]
         if self._primary and not self._ctx.hold_released:
-            hold = self._release_at if self._release_at is not None else self._next_hold_request
-            deadline = hold if deadline is None else min(deadline, hold)
-        return deadline
-
-    def _send_hold_request(self) -> None:
-        request = ManagerRequest(
-            request=PROVIDE_HOLD_STATE, client_name=self._ctx.client_name, client_pid=self._pid,
-            ready=self._ctx.ready_flag,
-        )
-        ident = make_identifier(
-            MANAGER_REQUEST_GROUP, Scheme.PROTOBUF, ManagerRequest.DESCRIPTOR.full_name, self._pid, self._thread_hex
-        )
-        try:
-            self._pub.send(encode_frame(ident, request.SerializeToString()), zmq.NOBLOCK)
-        except zmq.Again:
-            log.debug("%s: hold request not sent (queue full); retrying", self._thread_name)
+            deadlines.append(self._hold.deadline())
+        for deadline in (self._ledger.deadline(), None if self._disconnected else self._topics.deadline()):
+            if deadline is not None:
+                deadlines.append(deadline)
+        return min(deadlines) if deadlines else None
 
     def _on_manager_response(self, payload: bytes) -> None:
         try:
@@ -386,10 +417,7 @@ class InterProcessPortal:
         except Exception as exc:  # noqa: BLE001
             log.error("%s: malformed ManagerResponse: %s", self._thread_name, exc)
             return
-        if (response.request == PROVIDE_HOLD_STATE and response.client_pid == self._pid
-                and response.client_name == self._ctx.client_name and not response.hold
-                and self._release_at is None):
-            self._release_at = time.monotonic() + self._ctx.hold_settle_s
+        self._hold.on_response(response, time.monotonic())
 
     def _receive(self) -> int:
         count = 0
@@ -404,62 +432,19 @@ class InterProcessPortal:
         return count
 
     def _dispatch(self, frame: bytes) -> None:
-        nul = frame.find(b"\0")
-        if nul < 0:
-            self._malformed(frame, "frame has no /group/scheme/type/pid/thread/ identifier followed by NUL")
+        split = self._frames.split(frame)
+        if split is None:
             return
-        head = frame[:nul]
-        known = self._heads.get(head)
-        if known is None:  # first frame from this (group, scheme, type, process, thread): validate it once
-            try:
-                ident, _ = decode_frame(frame)
-            except IdentifierError as exc:
-                self._malformed(frame, str(exc))
-                return
-            cut = head.find(b"/", head.find(b"/", head.find(b"/", 1) + 1) + 1)  # fourth '/'
-            known = (ident, head[: cut + 1])
-            if len(self._heads) >= HEAD_CACHE_SIZE:
-                self._heads.clear()
-            self._heads[head] = known
-        ident, prefix = known
-        payload = frame[nul + 1:]
-        subs = self._subs.get(prefix)
+        head, ident, prefix, payload = split
+        if prefix == self._probe_prefix:  # a delivery probe: ours confirms, others' (regex subscribers) are dropped
+            if head == self._probe_head:
+                now = time.monotonic()
+                if self._ledger.confirm(payload, now):
+                    self._send_probe(now)
+            return
         if prefix == self._hold_response_prefix and self._primary:
             self._on_manager_response(payload)
-        if subs:
-            own = ident.pid == self._pid
-            parsed: dict[type, Any] = {}
-            for sub in list(subs):
-                if own and not sub.echo:
-                    continue
-                msg = parsed.get(sub.msg_type)
-                if msg is None:
-                    try:
-                        msg = parse(payload, sub.scheme, sub.msg_type, self._ctx.dccl)
-                    except MarshallingError as exc:
-                        log.error("%s: cannot decode publication on %s (%s): %s", self._thread_name, ident.group,
-                                  ident.type_name, exc)
-                        return
-                    parsed[sub.msg_type] = msg
-                try:
-                    sub.callback(msg)
-                except Exception:
-                    log.exception("%s: subscriber callback for %s (%s) raised; continuing", self._thread_name,
-                                  ident.group, ident.type_name)
-        for rsub in list(self._regex):
-            if ((Scheme.ALL_SCHEMES in rsub.schemes or ident.scheme in rsub.schemes)
-                    and rsub.type_re.fullmatch(ident.type_name) and rsub.group_re.fullmatch(ident.group)):
-                try:
-                    rsub.callback(payload, ident.scheme, ident.type_name, ident.group)
-                except Exception:
-                    log.exception("%s: regex subscriber callback raised; continuing", self._thread_name)
-
-    def _malformed(self, frame: bytes, why: str) -> None:
-        self.malformed += 1
-        if self.malformed > 10 and self.malformed % 1000:
-            return  # a flood: log the first ten, then every thousandth (the count says how many)
-        log.error("%s: dropping malformed frame (%d so far): %s: %r", self._thread_name, self.malformed, why,
-                  frame[:80])
+        self._frames.deliver(ident, prefix, payload)
 
     def _handle_monitor(self) -> int:
         from zmq.utils.monitor import recv_monitor_message
@@ -472,32 +457,33 @@ class InterProcessPortal:
                 return count
             count += 1
             kind = event["event"]
-            if kind == zmq.EVENT_DISCONNECTED:
+            if kind == zmq.EVENT_DISCONNECTED and not self._disconnected:
                 self._disconnected = True
+                self._topics.connection_lost()
                 self._report_in_doubt()
                 if self._cfg.transport == InterProcessPortalConfig.TCP:
-                    self._requery_at = time.monotonic() + 1.0
+                    self._requery.start(time.monotonic())
                 log.warning("%s: lost connection to the broker (%s); ZeroMQ will reconnect and resubscribe",
-                            self._thread_name, self._sub_endpoint)
+                            self._thread_name, self._pub_endpoint)
             elif kind == zmq.EVENT_CONNECTED:
                 if self._disconnected:
-                    log.warning("%s: reconnected to the broker (%s); %d subscription(s) restored",
-                                self._thread_name, self._sub_endpoint, len(self._subs) + len(self._regex))
-                    self._settle_until = time.monotonic() + RESUBSCRIBE_SETTLE_S
+                    log.warning("%s: reconnected to the broker (%s); %d subscription(s) restored; publications to "
+                                "the %d topic(s) that had subscribers wait for them to subscribe again",
+                                self._thread_name, self._pub_endpoint, len(self._subs) + len(self._regex),
+                                len(self._topics.missing))
+                    self._topics.reconnected(time.monotonic())
                 self._disconnected = False
                 self._ever_connected = True
-                self._requery_at = None
+                self._requery.cancel()
 
     def _report_in_doubt(self) -> None:
-        """The connection dropped: what was sent in the last IN_DOUBT_S may have died in the broker."""
-        cutoff = time.monotonic() - IN_DOUBT_S
-        lost = [(group, payload) for sent_at, group, payload in self._recent if sent_at >= cutoff]
-        self._recent.clear()
+        """The connection dropped: what no probe has confirmed may have died in the broker (or after it)."""
+        lost = self._ledger.in_doubt()
         if not lost:
             return
         self.in_doubt += len(lost)
-        log.warning("%s: %d publication(s) sent in the last %.1f s before the broker connection dropped may be "
-                    "lost; reported undelivered", self._thread_name, len(lost), IN_DOUBT_S)
+        log.warning("%s: %d publication(s) not yet confirmed through the broker when the connection dropped may "
+                    "be lost; reported undelivered", self._thread_name, len(lost))
         if self.on_undelivered is not None:
             try:
                 self.on_undelivered(lost)
@@ -521,6 +507,11 @@ class InterProcessPortal:
             )
 
     @property
+    def malformed(self) -> int:
+        """Frames dropped as malformed (logged: the first ten, then every thousandth)."""
+        return self._frames.malformed
+
+    @property
     def connected(self) -> bool:
         """True once the SUB socket is connected to the broker and not known to be disconnected."""
         return self._ever_connected and not self._disconnected
@@ -540,5 +531,6 @@ class InterProcessPortal:
         except zmq.ZMQError:
             pass
         self._monitor.close(linger=0)
+        self._requery.drop()
         self._sub.close(linger=0)
         self._pub.close()

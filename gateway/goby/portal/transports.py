@@ -48,8 +48,16 @@ class ThreadTransports:
             portal = InterProcessPortal(self.context, self.mailbox, self.thread_name)
             for sock in portal.pollables():
                 self._poller.register(sock, zmq.POLLIN)
+            portal.on_pollable = self._on_pollable
             self._interprocess = portal
         return self._interprocess
+
+    def _on_pollable(self, sock: zmq.Socket, add: bool) -> None:
+        """The portal opened (or closed) a socket of its own, e.g. a manager query after a TCP broker restart."""
+        if add:
+            self._poller.register(sock, zmq.POLLIN)
+        else:
+            self._poller.unregister(sock)
 
     @property
     def has_interprocess(self) -> bool:
@@ -87,6 +95,7 @@ class ThreadTransports:
         if self._interprocess is not None:
             for sock in self._interprocess.pollables():
                 self._poller.unregister(sock)
+            self._interprocess.on_pollable = None
             self._interprocess.close()
         self._poller.unregister(self.mailbox.fd)
         self.mailbox.close()
