@@ -4,6 +4,12 @@ Threads: :meth:`MapModel.ingest_node_status` and :meth:`ingest_command` run on t
 newest payload (under a lock held for microseconds); :meth:`tick` decodes them on the web thread, once per update
 period, so a fast node_status group costs the map one decode per vehicle per tick.  Positions are local x/y metres
 (``local_fix``; the frontseat interface fills it), drawn without map tiles.
+
+Why every value is checked here: anything on the broker reaches the map.  A USVCommand's polygon is drawn only
+within the message's own DCCL bounds (3..10 sides: 3,000,000 sides would cost seconds and hundreds of MB); a
+NodeStatus with a non-finite or absurd number is dropped (a NaN stored once would break the JSON of every later
+page); names are cut and vehicles are capped.  Each refusal is counted (:attr:`MapModel.refused`) and logged at
+most once per kind every 10 s.
 """
 
 from __future__ import annotations
@@ -11,13 +17,15 @@ from __future__ import annotations
 import logging
 import math
 import threading
-from collections import deque
+from collections import Counter, deque
 from dataclasses import dataclass, field
 from typing import Any
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
+from launch.liaison.form_schema import dccl_bounds
 from launch.usv.geometry import radial_polygon
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
+from util.ratelimit import RateLimitedLog
 
 log = logging.getLogger(__name__)
 
@@ -25,6 +33,21 @@ NODE_STATUS_TYPE = NodeStatus.DESCRIPTOR.full_name
 USV_COMMAND_TYPE = USVCommand.DESCRIPTOR.full_name
 Point = tuple[float, float]
 TRAIL_SPACING_M = 5.0  # a trail point is kept once the vehicle has moved this far from the last one
+MAX_VEHICLES = 256  # vehicles drawn; NodeStatus of further names is counted and dropped
+MAX_NAME_CHARS = 64
+MAX_COORDINATE_M = 1e7  # |x|, |y| of a local fix (10,000 km: beyond that the fix is garbage)
+MAX_POLYGON_SIDES = 360  # when the command type carries no DCCL bounds
+_USV_FIELDS = USVCommand.DESCRIPTOR.fields_by_name
+
+
+def _command_bounds(name: str, fallback: tuple[float, float]) -> tuple[float, float]:
+    """(min, max) of a USVCommand field from its DCCL options (what the link could ever carry)."""
+    bounds = dccl_bounds(_USV_FIELDS[name])
+    return (bounds[0], bounds[1]) if bounds is not None else fallback
+
+
+POLYGON_SIDES = _command_bounds("polygon_sides", (3, MAX_POLYGON_SIDES))
+POLYGON_RADIUS_M = _command_bounds("polygon_radius", (1e-3, MAX_COORDINATE_M))
 
 
 @dataclass(eq=False)
@@ -66,6 +89,12 @@ class MapModel:
         self._last_command_time: float | None = None
         self._overlay_changed = True
         self._centred = not center_activate
+        self.refused: Counter[str] = Counter()  # inputs dropped, by reason (web thread)
+        self._warn = RateLimitedLog(log, period_s=10.0)
+
+    def _refuse(self, reason: str, msg: str, *args: object) -> None:
+        self.refused[reason] += 1
+        self._warn.warning(reason, "map: " + msg + " (%d dropped for this reason so far)", *args, self.refused[reason])
 
     # ---------------------------------------------------------------------------------- portal thread
     def ingest_node_status(self, group: str, payload: bytes) -> None:
@@ -117,17 +146,27 @@ class MapModel:
         try:
             status.ParseFromString(payload)
         except Exception as exc:  # noqa: BLE001 - bad input from the broker: report, keep serving
-            log.warning("map: NodeStatus on %s does not parse: %s", group, exc)
+            self._refuse("unparsable", "NodeStatus on %s does not parse: %s", group, exc)
             return None
         if not status.HasField("local_fix"):
             return None
-        name = status.name or group
+        x, y = status.local_fix.x, status.local_fix.y
+        numbers = (x, y, status.pose.heading, status.speed.over_ground, status.time)
+        if not all(math.isfinite(v) for v in numbers) or max(abs(x), abs(y)) > MAX_COORDINATE_M:
+            self._refuse("non-finite", "NodeStatus on %s has a non-finite or out-of-range number (x %r, y %r, "
+                         "heading %r, speed %r, time %r): dropped", group, *numbers)
+            return None
+        name = (status.name or group)[:MAX_NAME_CHARS]
         vehicle = self._vehicles.get(name)
         if vehicle is None:
+            if len(self._vehicles) >= MAX_VEHICLES:
+                self._refuse("too-many-vehicles", "more than %d vehicles: NodeStatus of %r on %s dropped",
+                             MAX_VEHICLES, name, group)
+                return None
             vehicle = self._vehicles[name] = _Vehicle(name, deque(maxlen=self.trail_points))
         vehicle.type = NodeStatus.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_number[status.type].name \
             if status.HasField("type") else ""
-        vehicle.x, vehicle.y = status.local_fix.x, status.local_fix.y
+        vehicle.x, vehicle.y = x, y
         vehicle.heading = status.pose.heading % 360.0
         vehicle.speed = status.speed.over_ground
         vehicle.time = status.time
@@ -159,13 +198,20 @@ class MapModel:
         command = USVCommand()
         try:
             command.ParseFromString(payload)
-        except Exception as exc:  # noqa: BLE001
-            log.warning("map: USVCommand does not parse: %s", exc)
+        except Exception as exc:  # noqa: BLE001 - bad input from the broker: report, keep serving
+            self._refuse("unparsable", "USVCommand does not parse: %s", exc)
             return
         if command.time == self._last_command_time:
             return  # the same command seen again on another group (the manager republishes it)
         self._last_command_time = command.time
-        if command.desired_state == USVCommand.POLYGON and command.polygon_sides >= 3 and command.polygon_radius > 0:
+        if command.desired_state == USVCommand.POLYGON and not (
+                POLYGON_SIDES[0] <= command.polygon_sides <= POLYGON_SIDES[1]
+                and POLYGON_RADIUS_M[0] <= command.polygon_radius <= POLYGON_RADIUS_M[1]):
+            self._refuse("polygon-bounds", "USVCommand POLYGON with %d sides, radius %d is outside its DCCL bounds "
+                         "(sides %g..%g, radius %g..%g): not drawn", command.polygon_sides, command.polygon_radius,
+                         *POLYGON_SIDES, *POLYGON_RADIUS_M)
+            return
+        if command.desired_state == USVCommand.POLYGON:
             ring = radial_polygon(0.0, 0.0, command.polygon_radius, command.polygon_sides)
             self.polygon = [(round(x, 1), round(y, 1)) for x, y in ring.vertices]
             if self.center_activate:

@@ -39,12 +39,12 @@ class LiaisonApp(SingleThreadApplication):
     """One platform's web page: scope, commander and map, fed by one regex subscription on the broker."""
 
     def __init__(self, cfg: LiaisonConfig, settings: LiaisonSettings | None = None) -> None:
-        super().__init__(cfg, loop_frequency_hz=1.0)
-        try:
-            self.settings = settings or load_settings(cfg)
+        try:  # before joining the broker: a config error is named even when no broker runs
+            s = settings or load_settings(cfg)
         except LiaisonError as exc:
             raise StartError(f"goby-liaison: {exc}") from exc
-        s = self.settings
+        super().__init__(cfg, loop_frequency_hz=1.0)
+        self.settings = s
         self.scope = ScopeModel(s.max_history, s.max_rows, s.max_message_size)
         self.map = MapModel(s.waypoints, s.polygon, s.center_activate, s.trail_points)
         self.commander = CommanderModel(s.command_types, s.command_history)

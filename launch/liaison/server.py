@@ -11,26 +11,27 @@ one update per view to each page's bounded queue (``fanout.Browser``).
 from __future__ import annotations
 
 import asyncio
-import json
 import logging
-import re
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Awaitable, Callable
 from importlib import resources
 from pathlib import Path
 from typing import Any
-from urllib.parse import urlsplit
 
 from aiohttp import WSMsgType, web
 
 from launch.liaison.commander_model import CommanderModel, CommandType, SentCommand, Target
 from launch.liaison.errors import CommandRefused, LiaisonError
-from launch.liaison.fanout import VIEWS, Browser
+from launch.liaison.fanout import MATCH_BUDGET_S, VIEWS, Browser
 from launch.liaison.form_values import build_command
+from launch.liaison.http_guard import SECURITY_HEADERS, HostGuard
 from launch.liaison.map_model import MapModel
+from launch.liaison.name_filter import compile_filter
+from launch.liaison.page_messages import PageMessageError, encode, int_field, parse, str_field
 from launch.liaison.scope_model import ScopeModel
 from launch.liaison.settings import LiaisonSettings
+from util.ratelimit import RateLimitedLog
 
 log = logging.getLogger(__name__)
 
@@ -38,12 +39,21 @@ STATIC_DIR = Path(str(resources.files("launch.liaison") / "static"))
 MAX_WS_MESSAGE = 256 * 1024  # bytes a page may send in one WebSocket message
 HISTORY_ITEMS_SENT = 100
 SEND_RATE_LIMIT = 20  # commands a page may send per second
+MAX_COMMENT_CHARS = 1000
+MAX_FILTER_CHARS = 256
 #: Publishes a command on the portal thread: (type, target, message, entry id) -> None; never blocks.
 Publish = Callable[[CommandType, Target, Any, int], None]
 
 
+_bad_input = RateLimitedLog(log, period_s=10.0)
+
+
 def _json(obj: Any) -> str:
-    return json.dumps(obj, separators=(",", ":"), allow_nan=False, default=str)
+    """JSON for the pages; a non-finite number (which a model should have refused) becomes null, logged."""
+    text, replaced = encode(obj)
+    if replaced:
+        _bad_input.warning("non-finite", "a non-finite number reached the page's JSON: sent as null")
+    return text
 
 
 class WebServer:
@@ -64,7 +74,9 @@ class WebServer:
         self._ready = threading.Event()
         self._error: BaseException | None = None
         self._stop: asyncio.Event | None = None
-        self._notify_rules = [(re.compile(g), re.compile(t)) for g, t in settings.notify]
+        self._notify_rules = [(compile_filter(g, "group"), compile_filter(t, "type")) for g, t in settings.notify]
+        self.guard = HostGuard(settings.http_address, settings.allowed_hosts)
+        self.refused_requests = 0  # HTTP/WebSocket requests refused for their Host or Origin
         self._notified: dict[int, int] = {}  # row id -> count when last notified
         self.ticks = 0
 
@@ -129,7 +141,8 @@ class WebServer:
 
     async def _serve(self) -> None:
         self._stop = asyncio.Event()
-        app = web.Application(client_max_size=MAX_WS_MESSAGE)
+        app = web.Application(client_max_size=MAX_WS_MESSAGE, middlewares=[self._guard_middleware])
+        app.on_response_prepare.append(_add_security_headers)
         app.router.add_get("/", self._page)
         for view in ("scope", "commander", "map"):
             app.router.add_get(f"/{view}", self._page)
@@ -150,6 +163,8 @@ class WebServer:
         sockets = getattr(server, "sockets", None) or []
         self.port = sockets[0].getsockname()[1] if sockets else self.settings.http_port
         self._ready.set()
+        log.info("serving http on port %d for host names %s (and the address a connection arrives on)", self.port,
+                 self.guard.describe())
         ticker = asyncio.ensure_future(self._ticker())
         try:
             await self._stop.wait()
@@ -169,17 +184,32 @@ class WebServer:
     async def _api_urls(self, request: web.Request) -> web.Response:
         return web.json_response(self.urls)
 
-    def _origin_allowed(self, request: web.Request) -> bool:
-        """A page of another site must not drive this one (WebSockets ignore the same-origin policy)."""
+    @web.middleware
+    async def _guard_middleware(self, request: web.Request,
+                                handler: Callable[[web.Request], Awaitable[web.StreamResponse]]) -> web.StreamResponse:
+        """Every request: refuse a Host this server is not served under (DNS rebinding) with 421, and an Origin
+        of another site with 403 (WebSockets ignore the same-origin policy)."""
+        sockname = request.transport.get_extra_info("sockname") if request.transport is not None else None
+        local = str(sockname[0]) if sockname else None
+        host = request.headers.get("Host")
+        if not self.guard.host_allowed(host, local):
+            self.refused_requests += 1
+            _bad_input.warning(("host", request.remote), "refused a request from %s for Host %r (not one of %s; "
+                               "[goby_moos_py.liaison.protobuf.web] allowed_host)", request.remote, host,
+                               self.guard.describe())
+            return web.Response(status=421, text=f"this server does not serve host {host!r}: browse to it by one of "
+                                f"{self.guard.describe()}, or add the name to [goby_moos_py.liaison.protobuf.web] "
+                                "allowed_host")
         origin = request.headers.get("Origin")
-        if origin is None:
-            return True
-        return urlsplit(origin).netloc == request.host
+        if origin is not None and not self.guard.origin_allowed(origin, local):
+            self.refused_requests += 1
+            _bad_input.warning(("origin", request.remote), "refused a request from %s with Origin %r", request.remote,
+                               origin)
+            return web.Response(status=403, text=f"origin {origin} may not use this page")
+        return await handler(request)
 
     # -------------------------------------------------------------------------------------- websocket
     async def _websocket(self, request: web.Request) -> web.StreamResponse:
-        if not self._origin_allowed(request):
-            return web.Response(status=403, text=f"origin {request.headers.get('Origin')} may not use this page")
         if len(self.browsers) >= self.settings.max_clients:
             return web.Response(status=503, text=f"too many pages open ({self.settings.max_clients}, "
                                                  "[goby_moos_py.liaison.protobuf.web] max_clients): close one")
@@ -192,7 +222,7 @@ class WebServer:
         sender = asyncio.ensure_future(browser.send_loop())
         sent_times: list[float] = []
         try:
-            browser.offer(_json(self._hello()), "hello")
+            browser.reply(_json(self._hello()))
             async for message in ws:
                 if message.type == WSMsgType.TEXT:
                     self._handle(browser, message.data, sent_times)
@@ -200,6 +230,7 @@ class WebServer:
                     self._reply(browser, "error", error="binary messages are not understood: send JSON text")
                 elif message.type == WSMsgType.ERROR:
                     log.info("browser %s: %s", browser.address, ws.exception())
+                await browser.replies_drained()  # a page that sends but does not read is no longer read
         finally:
             self.browsers.discard(browser)
             sender.cancel()
@@ -212,17 +243,15 @@ class WebServer:
                 "max_history": s.max_history, "history_groups": s.history_groups}
 
     def _reply(self, browser: Browser, op: str, **fields: Any) -> None:
-        browser.offer(_json({"op": op, **fields}), "reply")
+        """The answer to one page message: on the reply queue, which is never dropped."""
+        browser.reply(_json({"op": op, **fields}))
 
     def _handle(self, browser: Browser, text: str, sent_times: list[float]) -> None:
-        """One message from a page: every bad one gets an ``error`` reply naming the cause."""
+        """One message from a page: every message gets an answer, a bad one an ``error`` naming the cause."""
         try:
-            request = json.loads(text)
-        except ValueError as exc:
-            self._reply(browser, "error", error=f"message is not JSON: {exc}")
-            return
-        if not isinstance(request, dict) or not isinstance(request.get("op"), str):
-            self._reply(browser, "error", error='message must be a JSON object with an "op" string')
+            request = parse(text)
+        except PageMessageError as exc:
+            self._reply(browser, "error", error=str(exc))
             return
         op = request["op"]
         handler = {
@@ -235,8 +264,11 @@ class WebServer:
             return
         try:
             handler(browser, request)
-        except (KeyError, TypeError, ValueError) as exc:
+        except (KeyError, TypeError, ValueError, ArithmeticError) as exc:
             self._reply(browser, "error", op_failed=op, error=f"bad {op} request: {exc}")
+        except Exception as exc:  # noqa: BLE001 - a bug must cost one reply, not the connection
+            _bad_input.error(("handler", op), "page message %r failed: %s: %s", op, type(exc).__name__, exc)
+            self._reply(browser, "error", op_failed=op, error=f"{op} failed on the server: {type(exc).__name__}")
 
     def _on_subscribe(self, browser: Browser, request: dict[str, Any]) -> None:
         views = request.get("views")
@@ -246,13 +278,13 @@ class WebServer:
         if unknown:
             raise ValueError(f"unknown view(s) {', '.join(sorted(unknown))} (known: {', '.join(sorted(VIEWS))})")
         browser.views = set(views)
+        self._reply(browser, "subscribed", views=sorted(browser.views))
         for view in browser.views:
             self._send_full(browser, view)
 
     def _on_filter(self, browser: Browser, request: dict[str, Any]) -> None:
-        group, type_ = request.get("group", ".*"), request.get("type", ".*")
-        if not isinstance(group, str) or not isinstance(type_, str):
-            raise ValueError('"group" and "type" must be strings')
+        group = str_field(request, "group", ".*", MAX_FILTER_CHARS)
+        type_ = str_field(request, "type", ".*", MAX_FILTER_CHARS)
         browser.set_filters(group, type_)  # ValueError names the bad expression
         self._reply(browser, "filter", group=group, type=type_)
         self._send_full(browser, "scope")
@@ -267,7 +299,7 @@ class WebServer:
         self._send_full(browser, "scope")
 
     def _on_expand(self, browser: Browser, request: dict[str, Any]) -> None:
-        row_id = int(request["id"])
+        row_id = int_field(request, "id")
         items = self.scope.history(row_id, HISTORY_ITEMS_SENT)
         if items is None:
             raise ValueError(f"no scope row {row_id}")
@@ -275,7 +307,8 @@ class WebServer:
         self._reply(browser, "history", id=row_id, items=items)
 
     def _on_collapse(self, browser: Browser, request: dict[str, Any]) -> None:
-        browser.expanded.discard(int(request["id"]))
+        browser.expanded.discard(int_field(request, "id"))
+        self._reply(browser, "collapsed", id=request["id"])
 
     def _on_send(self, browser: Browser, request: dict[str, Any], sent_times: list[float]) -> None:
         now = time.monotonic()
@@ -284,14 +317,16 @@ class WebServer:
             self._reply(browser, "refused", field="", error=f"more than {SEND_RATE_LIMIT} commands a second")
             return
         try:
+            comment = str_field(request, "comment", "", MAX_COMMENT_CHARS)
             kind, target, msg = self._check_command(request)
+        except PageMessageError as exc:
+            self._reply(browser, "refused", field="comment", error=str(exc))
+            return
         except CommandRefused as exc:
             self._reply(browser, "refused", field=exc.field, error=str(exc))
             return
         sent_times.append(now)
-        comment = request.get("comment", "")
-        entry = self.commander.record(kind, target, msg, browser.address, comment if isinstance(comment, str) else "",
-                                      self._now())
+        entry = self.commander.record(kind, target, msg, browser.address, comment, self._now())
         self._reply(browser, "accepted", id=entry.id, text=entry.text, target=entry.target)
         self._publish(kind, target, msg, entry.id)
         self._broadcast_sent([entry])
@@ -341,10 +376,14 @@ class WebServer:
             if "commander" in browser.views:
                 browser.offer(text, "commander")
 
-    def _send_full(self, browser: Browser, view: str) -> None:
+    def _send_full(self, browser: Browser, view: str, deadline: float | None = None) -> None:
+        """A whole view; the scope waits for a later tick when matching its filters is over budget."""
         if view == "scope":
-            rows = [r for r in self.scope.views() if browser.shows(r)] if not browser.paused else None
-            if rows is not None:
+            if not browser.paused:
+                rows = browser.visible(self.scope.views(), deadline)
+                if rows is None:  # matching took its time budget: the ticks go on until it is done
+                    browser.needs_resync.add("scope")
+                    return
                 browser.offer(_json({"op": "scope", "rows": rows, "full": True}), "scope")
         elif view == "commander":
             browser.offer(_json({"op": "commands", "types": self.commander.catalogue()}), "commander")
@@ -380,26 +419,37 @@ class WebServer:
         by_filter: dict[tuple[str, str], str] = {}
         changed_ids = {int(r["id"]) for r in rows}
         map_text = _json({"op": "map", "full": False, **map_update}) if map_update else None
-        for browser in list(self.browsers):
+        browsers = list(self.browsers)
+        turn = self.ticks % len(browsers) if browsers else 0
+        deadline = time.perf_counter() + MATCH_BUDGET_S  # for matching filters, all pages together
+        for browser in browsers[turn:] + browsers[:turn]:  # who goes first (and gets the match budget) rotates
             for view in list(browser.needs_resync):
                 if browser.has_room():
-                    self._send_full(browser, view)
+                    self._send_full(browser, view, deadline)
             if "scope" in browser.views and rows and not browser.paused and "scope" not in browser.needs_resync:
-                key = browser.filter_key
-                text = by_filter.get(key)
-                if text is None:
-                    shown = [r for r in rows if browser.shows(r)]
-                    text = by_filter[key] = _json({"op": "scope", "rows": shown, "full": False}) if shown else ""
-                if text:
-                    browser.offer(text, "scope")
-                for row_id in browser.expanded & changed_ids:
-                    items = self.scope.history(row_id, HISTORY_ITEMS_SENT)
-                    if items is not None:
-                        self._reply(browser, "history", id=row_id, items=items)
+                self._offer_scope(browser, rows, changed_ids, by_filter, deadline)
             if map_text and "map" in browser.views and "map" not in browser.needs_resync:
                 browser.offer(map_text, "map")
             if notices and "commander" in browser.views:
                 browser.offer(_json({"op": "notify", "items": notices}), "commander")
+
+    def _offer_scope(self, browser: Browser, rows: list[dict[str, Any]], changed_ids: set[int],
+                     by_filter: dict[tuple[str, str], str], deadline: float) -> None:
+        """The rows of this tick that pass the page's filters (one JSON text per distinct filter)."""
+        key = browser.filter_key
+        text = by_filter.get(key)
+        if text is None:
+            shown = browser.visible(rows, deadline)
+            if shown is None:  # out of match budget this tick: a full resync follows
+                browser.needs_resync.add("scope")
+                return
+            text = by_filter[key] = _json({"op": "scope", "rows": shown, "full": False}) if shown else ""
+        if text:
+            browser.offer(text, "scope")
+        for row_id in browser.expanded & changed_ids:
+            items = self.scope.history(row_id, HISTORY_ITEMS_SENT)
+            if items is not None:
+                browser.offer(_json({"op": "history", "id": row_id, "items": items}), "scope")
 
     def _notifications(self, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
         if not self._notify_rules:
@@ -413,3 +463,8 @@ class WebServer:
                 notices.append({"group": row["group"], "type": row["type"], "time": row["time"],
                                 "value": row["value"]})
         return notices
+
+
+async def _add_security_headers(request: web.Request, response: web.StreamResponse) -> None:
+    """Every response: a CSP without inline code, no framing, no sniffing, no referrer."""
+    response.headers.update(SECURITY_HEADERS)

@@ -3,11 +3,13 @@
 Reads Goby's ``LiaisonConfig`` and our extension ``[goby_moos_py.liaison.protobuf.web]``; imports the message
 modules it names; refuses (LiaisonConfigError naming the field) a type that cannot be found, a bad regex, a
 target layer this build cannot publish on, ``load_proto_file``/``load_proto_dir`` (no .proto compiler at run
-time here: compile and import instead).
+time here: compile and import instead), a number out of its range (``http_port: 70000`` would wrap to 4464
+at bind time).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from google.protobuf.message import Message
@@ -16,8 +18,8 @@ from gateway.goby.portal.marshalling import is_dccl
 from gateway.goby.protobuf.layer_pb2 import LAYER_INTERVEHICLE
 from launch.liaison.commander_model import CommandType, Target
 from launch.liaison.errors import LiaisonConfigError
-from launch.liaison.fanout import compile_filter
 from launch.liaison.message_types import find_message_type, import_project_protos, load_message_modules
+from launch.liaison.name_filter import compile_filter
 from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
 from launch.liaison.protobuf.liaison_web_pb2 import InterProcessAck, WebConfig, web
 
@@ -49,6 +51,7 @@ class LiaisonSettings:
     max_clients: int = 64
     max_rows: int = 5000
     command_history: int = 200
+    allowed_hosts: list[str] = field(default_factory=list)
 
 
 def web_config(cfg: LiaisonConfig) -> WebConfig:
@@ -84,6 +87,49 @@ def _ack_rules(rules: list[InterProcessAck]) -> dict[str, InterProcessAck]:
             raise LiaisonConfigError(f"{where}.final_field: {rule.ack_type} has no field {rule.final_field!r}")
         out[rule.command_type] = rule
     return out
+
+
+MAX_UPDATE_FREQ = 100.0  # Hz
+MAX_OVERLAY_POINTS = 10_000
+WEB = "[goby_moos_py.liaison.protobuf.web]"
+#: (where, field, lowest, highest) of every number the server uses as a port, a size or a count.
+_RANGES = (
+    ("", "http_port", 0, 65535),
+    (WEB, "client_queue_updates", 1, 10_000),
+    (WEB, "max_clients", 1, 10_000),
+    (WEB, "max_scope_rows", 1, 1_000_000),
+    (WEB, "command_history", 1, 100_000),
+)
+
+
+def _check_ranges(cfg: LiaisonConfig, extra: WebConfig) -> None:
+    for where, name, low, high in _RANGES:
+        value = getattr(extra if where else cfg, name)
+        if not low <= value <= high:
+            raise LiaisonConfigError(f"{where + '.' if where else ''}{name}: {value} is outside [{low}, {high}]")
+    if not 1 <= cfg.pb_scope_config.max_history_items <= 100_000:
+        raise LiaisonConfigError(f"pb_scope_config.max_history_items: {cfg.pb_scope_config.max_history_items} "
+                                 "is outside [1, 100000]")
+    if not 2 <= extra.map.trail_points <= 100_000:
+        raise LiaisonConfigError(f"{WEB}.map.trail_points: {extra.map.trail_points} is outside [2, 100000]")
+    for name in ("waypoint", "loiter_polygon"):
+        points = getattr(extra.map, name)
+        if len(points) > MAX_OVERLAY_POINTS:
+            raise LiaisonConfigError(f"{WEB}.map.{name}: {len(points)} points (at most {MAX_OVERLAY_POINTS})")
+        for index, point in enumerate(points):
+            if not (math.isfinite(point.x) and math.isfinite(point.y)):
+                raise LiaisonConfigError(f"{WEB}.map.{name}[{index}]: x and y must be finite numbers")
+
+
+def _host_name(host: str, index: int) -> str:
+    """An ``allowed_host`` entry as the server compares it: lower case, no port, no brackets."""
+    name = host.strip().lower()
+    if name.startswith("[") and name.endswith("]"):
+        name = name[1:-1]
+    if not name or any(c in name for c in "/ @[]") or name.count(":") == 1:
+        raise LiaisonConfigError(f"{WEB}.allowed_host[{index}]: {host!r} is not a host name or address "
+                                 '(give the name without a port or scheme, e.g. "usv.local")')
+    return name
 
 
 def load_settings(cfg: LiaisonConfig) -> LiaisonSettings:
@@ -123,8 +169,10 @@ def load_settings(cfg: LiaisonConfig) -> LiaisonSettings:
             except ValueError as exc:
                 raise LiaisonConfigError(f"pb_commander_config.notify_subscribe[{index}]: {exc}") from None
         notify.append((sub.group_regex, sub.type_regex))
-    if not cfg.update_freq > 0:
-        raise LiaisonConfigError(f"update_freq must be > 0 Hz, not {cfg.update_freq:g}")
+    if not 0 < cfg.update_freq <= MAX_UPDATE_FREQ:
+        raise LiaisonConfigError(f"update_freq must be in (0, {MAX_UPDATE_FREQ:g}] Hz, not {cfg.update_freq:g}")
+    _check_ranges(cfg, extra)
+    allowed_hosts = [_host_name(h, index) for index, h in enumerate(extra.allowed_host)]
     platform = cfg.interprocess.platform
     return LiaisonSettings(
         title=f"goby liaison: {platform}",
@@ -149,4 +197,5 @@ def load_settings(cfg: LiaisonConfig) -> LiaisonSettings:
         max_clients=extra.max_clients,
         max_rows=extra.max_scope_rows,
         command_history=extra.command_history,
+        allowed_hosts=allowed_hosts,
     )

@@ -52,7 +52,7 @@ class InterProcessAck(_message.Message):
     def __init__(self, command_type: _Optional[str] = ..., ack_type: _Optional[str] = ..., ack_group: _Optional[str] = ..., command_field: _Optional[str] = ..., ack_field: _Optional[str] = ..., final_field: _Optional[str] = ..., final_value: _Optional[_Iterable[str]] = ..., refused_value: _Optional[str] = ..., timeout: _Optional[float] = ...) -> None: ...
 
 class WebConfig(_message.Message):
-    __slots__ = ("load_python_module", "map", "interprocess_ack", "client_queue_updates", "max_clients", "max_scope_rows", "command_history")
+    __slots__ = ("load_python_module", "map", "interprocess_ack", "client_queue_updates", "max_clients", "max_scope_rows", "command_history", "allowed_host")
     LOAD_PYTHON_MODULE_FIELD_NUMBER: _ClassVar[int]
     MAP_FIELD_NUMBER: _ClassVar[int]
     INTERPROCESS_ACK_FIELD_NUMBER: _ClassVar[int]
@@ -60,6 +60,7 @@ class WebConfig(_message.Message):
     MAX_CLIENTS_FIELD_NUMBER: _ClassVar[int]
     MAX_SCOPE_ROWS_FIELD_NUMBER: _ClassVar[int]
     COMMAND_HISTORY_FIELD_NUMBER: _ClassVar[int]
+    ALLOWED_HOST_FIELD_NUMBER: _ClassVar[int]
     load_python_module: _containers.RepeatedScalarFieldContainer[str]
     map: MapConfig
     interprocess_ack: _containers.RepeatedCompositeFieldContainer[InterProcessAck]
@@ -67,4 +68,5 @@ class WebConfig(_message.Message):
     max_clients: int
     max_scope_rows: int
     command_history: int
-    def __init__(self, load_python_module: _Optional[_Iterable[str]] = ..., map: _Optional[_Union[MapConfig, _Mapping]] = ..., interprocess_ack: _Optional[_Iterable[_Union[InterProcessAck, _Mapping]]] = ..., client_queue_updates: _Optional[int] = ..., max_clients: _Optional[int] = ..., max_scope_rows: _Optional[int] = ..., command_history: _Optional[int] = ...) -> None: ...
+    allowed_host: _containers.RepeatedScalarFieldContainer[str]
+    def __init__(self, load_python_module: _Optional[_Iterable[str]] = ..., map: _Optional[_Union[MapConfig, _Mapping]] = ..., interprocess_ack: _Optional[_Iterable[_Union[InterProcessAck, _Mapping]]] = ..., client_queue_updates: _Optional[int] = ..., max_clients: _Optional[int] = ..., max_scope_rows: _Optional[int] = ..., command_history: _Optional[int] = ..., allowed_host: _Optional[_Iterable[str]] = ...) -> None: ...
