@@ -98,8 +98,10 @@ def test_gating_status_period_publications_datum_and_helm_expiry(tmp_path: Path)
             raw_in = client.collect(groups.raw_in, fs.Raw)
             responses = client.collect(groups.command_response, fs.CommandResponse)
             assert client.wait_subscribed()
-            # the first-tick status may predate our subscription; one period later there is surely one
+            # the first-tick status may or may not predate our subscription; one period later there is surely one,
+            # and until the interface has sent it (its next one is due a period after it) a count would be early
             ScriptedDriverDouble.clock.t += STATUS_PERIOD
+            wait_until(lambda: app._next_status == ScriptedDriverDouble.clock.t + STATUS_PERIOD, what="2nd status")
             assert client.poll_until(lambda: len(status) >= 1)
             client.poll(0.3)
             seen = len(status)

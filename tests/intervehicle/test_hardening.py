@@ -301,7 +301,7 @@ def test_forged_frames_from_another_host_are_dropped(tmp_path: Path, namespaces:
         f"intervehicle {{\n{link_block(2, g1, p1, SAT)}\n"
         "link { modem_id: 514 subnet_mask: 0xFF00 driver { driver_type: DRIVER_UDP_MULTICAST "
         f"[goby.acomms.udp_multicast.protobuf.config] {{ listen_address: \"{NET}.1\" multicast_address: \"{g2}\" "
-        f"multicast_port: {p2} peer_address: \"{NET}.3\" }} }} "
+        f"multicast_port: {p2} }} [goby_moos_py.acomms.protobuf.udp_peers] {{ peer_address: \"{NET}.3\" }} }} "
         "mac { type: MAC_FIXED_DECENTRALIZED slot { src: 513 slot_seconds: 5 max_frame_bytes: 64 } "
         "slot { src: 514 slot_seconds: 5 max_frame_bytes: 64 } } }\n}\n")
     cfg_path = tmp_path / "gobyd_ns.pb.cfg"

@@ -15,7 +15,7 @@ import pytest
 from google.protobuf import text_format
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
-from gateway.goby.portal.testing import PortalClient, broker_process, running_app
+from gateway.goby.portal.testing import PortalClient
 from launch.liaison.errors import LiaisonConfigError
 from launch.liaison.fanout import Browser
 from launch.liaison.http_guard import HostGuard
@@ -26,9 +26,8 @@ from launch.liaison.protobuf import liaison_web_pb2  # noqa: F401 - the [..web] 
 from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
 from launch.liaison.settings import load_settings
 from launch.liaison.testing import browser_skip_reason, chromium
-from tests.liaison.test_server import CONFIG, receive_until, ws_url
+from tests.liaison.test_server import CONFIG, liaison_on_broker, receive_until, ws_url
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
-from util.process import free_port
 
 HOSTS_CONFIG = CONFIG.replace("  client_queue_updates: 4\n", '  client_queue_updates: 4\n  allowed_host: "usv.local"\n')
 COMMAND = {"op": "send", "type": "goby3_course.dccl.USVCommand", "target": 0,
@@ -37,12 +36,8 @@ COMMAND = {"op": "send", "type": "goby3_course.dccl.USVCommand", "target": 0,
 
 @pytest.fixture
 def liaison(tmp_path):
-    with broker_process(tmp_path, platform="web") as broker:
-        cfg = text_format.Parse(HOSTS_CONFIG.format(port=free_port()), LiaisonConfig())
-        cfg.interprocess.CopyFrom(broker.interprocess_config())
-        with running_app(LiaisonApp, cfg) as app, PortalClient(broker.interprocess_config()) as client:
-            client.wait_subscribed()
-            yield app, client
+    with liaison_on_broker(tmp_path, HOSTS_CONFIG) as pair:
+        yield pair
 
 
 def publish_and_wait(app: LiaisonApp, client: PortalClient, group: str, msg: object) -> None:
@@ -247,7 +242,7 @@ def test_every_command_of_a_burst_is_answered(liaison):
     async def scenario():
         async with aiohttp.ClientSession() as session, session.ws_connect(ws_url(app)) as ws:
             await ws.send_json({"op": "subscribe", "views": ["commander"]})
-            await receive_until(ws, lambda m: m["op"] == "subscribed")
+            await receive_until(ws, lambda m: m["op"] == "commands")
             for _ in range(20):
                 await ws.send_json(COMMAND)
             await ws.send_json(COMMAND)  # the 21st within the second is refused, and says so

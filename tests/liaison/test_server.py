@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import socket
 import time
@@ -43,14 +44,21 @@ CONFIG = COMMANDER_CONFIG_HEAD + """\
 """
 
 
-@pytest.fixture
-def liaison(tmp_path):
+@contextlib.contextmanager
+def liaison_on_broker(tmp_path, config: str = CONFIG):
+    """A liaison (``config`` with ``{port}``) and a test client on a fresh broker."""
     with broker_process(tmp_path, platform="web") as broker:
-        cfg = text_format.Parse(CONFIG.format(port=free_port()), LiaisonConfig())
+        cfg = text_format.Parse(config.format(port=free_port()), LiaisonConfig())
         cfg.interprocess.CopyFrom(broker.interprocess_config())
         with running_app(LiaisonApp, cfg) as app, PortalClient(broker.interprocess_config()) as client:
             client.wait_subscribed()
             yield app, client
+
+
+@pytest.fixture
+def liaison(tmp_path):
+    with liaison_on_broker(tmp_path) as pair:
+        yield pair
 
 
 def ws_url(app: LiaisonApp) -> str:

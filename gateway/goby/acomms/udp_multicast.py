@@ -7,8 +7,8 @@ deliver only datagrams sent to the group, never unicast to the port; joining on 
 ``IP_MULTICAST_ALL`` off delivers only what arrived on that interface. A loopback ``listen_address`` joins and
 sends on 127.0.0.1 (``IP_MULTICAST_IF``), which needs no multicast route and never leaves the machine; 0.0.0.0
 joins on the default interface, as Goby does; any other address joins on the interface that has it. Datagrams
-from a source outside ``peer_address`` (loopback listen: outside 127.0.0.0/8) are dropped, counted and logged at a
-rate-limited cadence.
+from a source outside ``peer_address`` (our ``udp_peers`` extension; loopback listen: outside 127.0.0.0/8) are
+dropped, counted and logged at a rate-limited cadence.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ import struct
 from gateway.goby.acomms.driver import DatagramDriver
 from gateway.goby.acomms.errors import ModemDriverError
 from gateway.goby.acomms.protobuf import udp_multicast_driver_pb2 as udp_pb
+from gateway.goby.acomms.protobuf import udp_peers_pb2 as udp_peers_pb
 from gateway.goby.acomms.protobuf.driver_base_pb2 import DriverConfig
 from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
 
@@ -74,14 +75,15 @@ def multicast_interface(listen_address: str) -> str:
     return str(address)
 
 
-def peer_networks(mc: udp_pb.Config) -> list[Network] | None:
-    """The source networks datagrams are accepted from (None: any); raises ``ModemDriverError`` naming a bad one."""
+def peer_networks(cfg: DriverConfig, mc: udp_pb.Config) -> list[Network] | None:
+    """The source networks datagrams are accepted from (None: any), from our ``udp_peers`` extension of the driver
+    block; raises ``ModemDriverError`` naming a bad one."""
     networks: list[Network] = []
-    for i, text in enumerate(mc.peer_address):
+    for i, text in enumerate(cfg.Extensions[udp_peers_pb.udp_peers].peer_address):
         try:
             networks.append(ipaddress.ip_network(text, strict=False))
         except ValueError as exc:
-            raise ModemDriverError(f"udp_multicast.peer_address[{i}] {text!r}: {exc}") from None
+            raise ModemDriverError(f"udp_peers.peer_address[{i}] {text!r}: {exc}") from None
     if networks:
         return networks
     return [LOOPBACK_NET] if multicast_interface(mc.listen_address) == "127.0.0.1" else None
@@ -119,7 +121,7 @@ class UDPMulticastDriver(DatagramDriver):
             interface = multicast_interface(self._mc.listen_address)
         except ValueError as exc:
             raise ModemDriverError(f"udp_multicast.listen_address {self._mc.listen_address!r}: {exc}") from None
-        self._peers = peer_networks(self._mc)
+        self._peers = peer_networks(cfg, self._mc)
         try:
             # The group, not listen_address: on Linux a socket bound to a unicast address receives no multicast.
             sock = join_multicast(group, port, interface)

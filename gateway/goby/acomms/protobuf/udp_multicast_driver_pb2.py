@@ -25,7 +25,7 @@ _sym_db = _symbol_database.Default()
 from gateway.goby.acomms.protobuf import driver_base_pb2 as gateway_dot_goby_dot_acomms_dot_protobuf_dot_driver__base__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n7gateway/goby/acomms/protobuf/udp_multicast_driver.proto\x12\"goby.acomms.udp_multicast.protobuf\x1a.gateway/goby/acomms/protobuf/driver_base.proto\"\xa4\x02\n\x06\x43onfig\x12\x1f\n\x0elisten_address\x18\x01 \x01(\t:\x07\x30.0.0.0\x12&\n\x11multicast_address\x18\x02 \x01(\t:\x0b\x32\x33\x39.142.0.1\x12\x1d\n\x0emulticast_port\x18\x03 \x01(\r:\x05\x35\x30\x30\x32\x31\x12\x1c\n\x0emax_frame_size\x18\x04 \x01(\x05:\x04\x31\x34\x30\x30\x12O\n\rrate_to_bytes\x18\x05 \x03(\x0b\x32\x38.goby.acomms.udp_multicast.protobuf.Config.RateBytesPair\x12\x15\n\x0cpeer_address\x18\xe8\x07 \x03(\t\x1a,\n\rRateBytesPair\x12\x0c\n\x04rate\x18\x01 \x02(\x05\x12\r\n\x05\x62ytes\x18\x02 \x02(\x05:_\n\x06\x63onfig\x12\".goby.acomms.protobuf.DriverConfig\x18\xbe\n \x01(\x0b\x32*.goby.acomms.udp_multicast.protobuf.Config')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n7gateway/goby/acomms/protobuf/udp_multicast_driver.proto\x12\"goby.acomms.udp_multicast.protobuf\x1a.gateway/goby/acomms/protobuf/driver_base.proto\"\x8d\x02\n\x06\x43onfig\x12\x1f\n\x0elisten_address\x18\x01 \x01(\t:\x07\x30.0.0.0\x12&\n\x11multicast_address\x18\x02 \x01(\t:\x0b\x32\x33\x39.142.0.1\x12\x1d\n\x0emulticast_port\x18\x03 \x01(\r:\x05\x35\x30\x30\x32\x31\x12\x1c\n\x0emax_frame_size\x18\x04 \x01(\x05:\x04\x31\x34\x30\x30\x12O\n\rrate_to_bytes\x18\x05 \x03(\x0b\x32\x38.goby.acomms.udp_multicast.protobuf.Config.RateBytesPair\x1a,\n\rRateBytesPair\x12\x0c\n\x04rate\x18\x01 \x02(\x05\x12\r\n\x05\x62ytes\x18\x02 \x02(\x05:_\n\x06\x63onfig\x12\".goby.acomms.protobuf.DriverConfig\x18\xbe\n \x01(\x0b\x32*.goby.acomms.udp_multicast.protobuf.Config')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
@@ -33,7 +33,7 @@ _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'gateway.goby.acomms.protobu
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
   _globals['_CONFIG']._serialized_start=144
-  _globals['_CONFIG']._serialized_end=436
-  _globals['_CONFIG_RATEBYTESPAIR']._serialized_start=392
-  _globals['_CONFIG_RATEBYTESPAIR']._serialized_end=436
+  _globals['_CONFIG']._serialized_end=413
+  _globals['_CONFIG_RATEBYTESPAIR']._serialized_start=369
+  _globals['_CONFIG_RATEBYTESPAIR']._serialized_end=413
 # @@protoc_insertion_point(module_scope)

@@ -10,7 +10,7 @@ CONFIG_FIELD_NUMBER: _ClassVar[int]
 config: _descriptor.FieldDescriptor
 
 class Config(_message.Message):
-    __slots__ = ("listen_address", "multicast_address", "multicast_port", "max_frame_size", "rate_to_bytes", "peer_address")
+    __slots__ = ("listen_address", "multicast_address", "multicast_port", "max_frame_size", "rate_to_bytes")
     class RateBytesPair(_message.Message):
         __slots__ = ("rate", "bytes")
         RATE_FIELD_NUMBER: _ClassVar[int]
@@ -23,11 +23,9 @@ class Config(_message.Message):
     MULTICAST_PORT_FIELD_NUMBER: _ClassVar[int]
     MAX_FRAME_SIZE_FIELD_NUMBER: _ClassVar[int]
     RATE_TO_BYTES_FIELD_NUMBER: _ClassVar[int]
-    PEER_ADDRESS_FIELD_NUMBER: _ClassVar[int]
     listen_address: str
     multicast_address: str
     multicast_port: int
     max_frame_size: int
     rate_to_bytes: _containers.RepeatedCompositeFieldContainer[Config.RateBytesPair]
-    peer_address: _containers.RepeatedScalarFieldContainer[str]
-    def __init__(self, listen_address: _Optional[str] = ..., multicast_address: _Optional[str] = ..., multicast_port: _Optional[int] = ..., max_frame_size: _Optional[int] = ..., rate_to_bytes: _Optional[_Iterable[_Union[Config.RateBytesPair, _Mapping]]] = ..., peer_address: _Optional[_Iterable[str]] = ...) -> None: ...
+    def __init__(self, listen_address: _Optional[str] = ..., multicast_address: _Optional[str] = ..., multicast_port: _Optional[int] = ..., max_frame_size: _Optional[int] = ..., rate_to_bytes: _Optional[_Iterable[_Union[Config.RateBytesPair, _Mapping]]] = ...) -> None: ...

@@ -2,6 +2,7 @@ from gateway.goby.protobuf import app_config_pb2 as _app_config_pb2
 from gateway.goby.protobuf import interprocess_config_pb2 as _interprocess_config_pb2
 from gateway.goby.intervehicle.protobuf import intervehicle_pb2 as _intervehicle_pb2
 from gateway.goby.acomms.protobuf import udp_multicast_driver_pb2 as _udp_multicast_driver_pb2
+from gateway.goby.acomms.protobuf import udp_peers_pb2 as _udp_peers_pb2
 from google.protobuf import descriptor as _descriptor
 from google.protobuf import message as _message
 from collections.abc import Mapping as _Mapping
