@@ -12,6 +12,7 @@ from gateway.goby.portal.subscription_evidence import (
 )
 
 IDENT = "/nav/PROTOBUF/Sample/12/ab/"
+LOG_IDENT = "/log/CSTR/CSTR/12/ab/"
 
 
 def test_a_prefix_subscription_makes_a_topic_live_until_it_is_withdrawn() -> None:
@@ -32,6 +33,7 @@ def test_after_a_drop_a_topic_is_missing_until_it_subscribes_again() -> None:
     topics = SubscriptionEvidence()
     topics.on_subscription_message(b"\x01/nav/")
     topics.on_subscription_message(b"\x01/log/")
+    topics.classify(IDENT), topics.classify(LOG_IDENT)  # we publish on both
     topics.connection_lost()
     topics.on_subscription_message(b"\x00/nav/")  # ZeroMQ withdraws the dead broker's subscriptions
     topics.reconnected(100.0)
@@ -47,6 +49,7 @@ def test_topics_that_do_not_come_back_are_given_up_after_the_wait() -> None:
     topics = SubscriptionEvidence()
     topics.on_subscription_message(b"\x01/nav/")
     topics.on_subscription_message(b"\x01/log/")
+    topics.classify(IDENT), topics.classify(LOG_IDENT)  # we publish on both
     topics.connection_lost()
     topics.on_subscription_message(b"\x00/nav/")
     topics.on_subscription_message(b"\x00/log/")
@@ -55,3 +58,15 @@ def test_topics_that_do_not_come_back_are_given_up_after_the_wait() -> None:
     assert topics.classify(IDENT) == MISSING
     assert topics.give_up(RESUBSCRIBE_WAIT_S) == [b"/log/", b"/nav/"]
     assert topics.classify(IDENT) == UNTRACKED and topics.deadline() is None
+
+
+def test_only_topics_we_publish_to_wait_after_a_drop() -> None:
+    """Other threads' subscriptions (their delivery probes, say) reach our XPUB too: they must not hold us up."""
+    topics = SubscriptionEvidence()
+    topics.on_subscription_message(b"\x01/nav/")
+    topics.on_subscription_message(b"\x01/goby::zeromq::_internal_delivery_probe/CSTR/CSTR/99/cd/")
+    topics.classify(IDENT)
+    topics.connection_lost()
+    topics.reconnected(0.0)
+    assert topics.missing == {b"/nav/"}
+    assert topics.on_subscription_message(b"\x01/nav/")  # the only one we wait for

@@ -24,12 +24,15 @@ class SubscriptionEvidence:
         self.missing: set[bytes] = set()
         self.missing_until = 0.0
         self._classes: dict[str, int] = {}  # identifier -> class, cleared whenever the topics change
+        self._published: set[bytes] = set()  # every identifier published through this socket (only these wait)
 
     def classify(self, ident: str) -> int:
         """Whether publications under ``ident`` reach a subscriber, wait for one to come back, or have none."""
         kind = self._classes.get(ident)
         if kind is None:
-            kind = self._classes[ident] = self._match(ident.encode())
+            head = ident.encode()
+            self._published.add(head)
+            kind = self._classes[ident] = self._match(head)
         return kind
 
     def _match(self, head: bytes) -> int:
@@ -56,8 +59,10 @@ class SubscriptionEvidence:
         return False
 
     def connection_lost(self) -> None:
-        """Every topic with a subscriber now must come back before it is published to again."""
-        self.missing |= self.live
+        """Every topic with a subscriber that we publish to must come back before it is published to again (the
+        subscriptions of topics we never published, e.g. other threads' probes, are not waited for)."""
+        self.missing |= {topic for topic in self.live
+                         if any(head.startswith(topic) or topic.startswith(head) for head in self._published)}
         self._classes.clear()
 
     def reconnected(self, now: float) -> None:
