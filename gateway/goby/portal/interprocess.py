@@ -40,7 +40,7 @@ from gateway.goby.portal.hold_handshake import HoldHandshake
 from gateway.goby.portal.identifier import EVERYTHING, encode_frame, make_identifier, thread_id, type_prefix
 from gateway.goby.portal.interface_registry import InterfaceEntry
 from gateway.goby.portal.interthread import type_key
-from gateway.goby.portal.mailbox import Mailbox
+from util.reactor import Mailbox
 from gateway.goby.portal.manager_client import request_endpoints
 from gateway.goby.portal.marshalling import (
     Scheme,

@@ -19,7 +19,7 @@ from google.protobuf import message as pb_message
 from gateway.goby.portal.errors import ClosedError
 from gateway.goby.portal.group import GroupLike, as_group, check_named
 from gateway.goby.portal.interface_registry import InterfaceEntry, InterfaceRegistry
-from gateway.goby.portal.mailbox import Mailbox
+from util.reactor import Mailbox
 from gateway.goby.portal.marshalling import Scheme
 
 LAYER = "interthread"

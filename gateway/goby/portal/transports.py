@@ -12,7 +12,7 @@ from gateway.goby.portal.context import ProcessContext
 from gateway.goby.portal.errors import ClosedError
 from gateway.goby.portal.interprocess import InterProcessPortal
 from gateway.goby.portal.interthread import InterThreadTransporter
-from gateway.goby.portal.mailbox import Mailbox
+from util.reactor import Mailbox
 
 log = logging.getLogger(__name__)
 
@@ -23,7 +23,7 @@ class ThreadTransports:
     def __init__(self, context: ProcessContext, thread_name: str) -> None:
         self.context = context
         self.thread_name = thread_name
-        self.mailbox = Mailbox(thread_name)
+        self.mailbox = Mailbox(thread_name, ClosedError)
         self._poller = zmq.Poller()
         self._poller.register(self.mailbox.fd, zmq.POLLIN)
         self._interthread = InterThreadTransporter(
