@@ -22,9 +22,9 @@ import zmq
 from gateway.goby.dccl import Codec as DcclCodec
 from gateway.goby.portal.interface_registry import InterfaceRegistry
 from gateway.goby.portal.interthread import InterThread
-from util.reactor import Mailbox
 from gateway.goby.portal.timeutil import SystemClock
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from util.reactor import Mailbox
 
 log = logging.getLogger(__name__)
 

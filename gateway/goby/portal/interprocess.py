@@ -40,7 +40,6 @@ from gateway.goby.portal.hold_handshake import HoldHandshake
 from gateway.goby.portal.identifier import EVERYTHING, encode_frame, make_identifier, thread_id, type_prefix
 from gateway.goby.portal.interface_registry import InterfaceEntry
 from gateway.goby.portal.interthread import type_key
-from util.reactor import Mailbox
 from gateway.goby.portal.manager_client import request_endpoints
 from gateway.goby.portal.marshalling import (
     Scheme,
@@ -52,6 +51,7 @@ from gateway.goby.portal.marshalling import (
 from gateway.goby.portal.subscription_evidence import LIVE, MISSING, RESUBSCRIBE_WAIT_S, SubscriptionEvidence
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from gateway.goby.protobuf.interprocess_zeromq_pb2 import ManagerResponse
+from util.reactor import Mailbox
 
 log = logging.getLogger(__name__)
 

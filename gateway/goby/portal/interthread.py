@@ -19,8 +19,8 @@ from google.protobuf import message as pb_message
 from gateway.goby.portal.errors import ClosedError
 from gateway.goby.portal.group import GroupLike, as_group, check_named
 from gateway.goby.portal.interface_registry import InterfaceEntry, InterfaceRegistry
-from util.reactor import Mailbox
 from gateway.goby.portal.marshalling import Scheme
+from util.reactor import Mailbox
 
 LAYER = "interthread"
 

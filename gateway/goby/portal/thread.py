@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import logging
 import math
-import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -18,6 +17,7 @@ from gateway.goby.portal.interprocess import InterProcessPortal
 from gateway.goby.portal.interthread import InterThreadTransporter
 from gateway.goby.portal.transports import ThreadTransports
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from util.reactor import Reactor, Timer
 
 if TYPE_CHECKING:
     from gateway.goby.intervehicle.forwarder import InterVehicleForwarder
@@ -60,7 +60,8 @@ class SimpleThread:
         self._transports = ThreadTransports(context, type(self).__qualname__)
         self._alive = True
         self._closed = False
-        self._next_loop: float | None = None
+        self._loop_timer: Timer | None = None
+        self._loop_error: Exception | None = None
         self._intervehicle: Any = None
 
     # ------------------------------------------------------------------------------------ accessors
@@ -102,6 +103,11 @@ class SimpleThread:
         return self._transports.interthread()
 
     @property
+    def reactor(self) -> Reactor:
+        """The thread's event loop: register sockets, descriptors and timers here (owning thread only)."""
+        return self._transports.reactor
+
+    @property
     def alive(self) -> bool:
         return self._alive
 
@@ -136,10 +142,10 @@ class SimpleThread:
         return self._transports.poll(timeout_s)
 
     def run_once(self) -> None:
-        """One iteration: poll until the next loop tick (or an event), then ``loop()`` if the tick is due.
+        """One iteration: wait for an event or the next loop tick and run it.
 
-        Unlike Goby (which calls ``loop()`` only when a poll times out), a due tick runs even under steady
-        traffic, so heavy subscriptions cannot starve ``loop()``.
+        ``loop()`` is a periodic timer of the thread's reactor, so a due tick runs even under steady traffic
+        (unlike Goby, which calls ``loop()`` only when a poll times out) and an idle thread sleeps until it.
         """
         hz = self.effective_loop_frequency_hz()
         if hz <= 0:
@@ -149,17 +155,23 @@ class SimpleThread:
             self._transports.poll(0.0)
             self.loop()
             return
-        interval = 1.0 / hz
-        now = time.monotonic()
-        if self._next_loop is None:
-            self._next_loop = (math.floor(now / interval) + 1) * interval
-        self._transports.poll(max(0.0, self._next_loop - now))
-        now = time.monotonic()
-        if now >= self._next_loop and self._alive:
-            self.loop()
-            self._next_loop += interval
-            if self._next_loop <= now:  # fell behind: skip the missed ticks rather than bursting
-                self._next_loop = (math.floor(now / interval) + 1) * interval
+        if self._loop_timer is None or not self._loop_timer.active:
+            self._loop_timer = self._transports.reactor.call_every(self._loop_period, self._tick)
+        self._transports.poll(None)
+        error, self._loop_error = self._loop_error, None
+        if error is not None:
+            raise error
+
+    def _loop_period(self) -> float:
+        hz = self.effective_loop_frequency_hz()
+        return 1.0 / hz if hz > 0 else math.inf
+
+    def _tick(self) -> None:
+        if self._alive:
+            try:
+                self.loop()
+            except Exception as exc:  # noqa: BLE001 - re-raised by run_once: a failing loop() ends the thread
+                self._loop_error = exc
 
     def run(self) -> None:
         """``initialize()``, loop until ``quit()``, ``finalize()``; runs on the calling thread."""

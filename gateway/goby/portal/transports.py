@@ -1,9 +1,8 @@
-"""The per-thread transport set: mailbox, interthread handle, lazily-connected interprocess portal, one poller."""
+"""The per-thread transport set: a reactor (with its mailbox), interthread handle, lazily-connected interprocess portal."""
 
 from __future__ import annotations
 
 import logging
-import math
 import time
 
 import zmq
@@ -12,24 +11,24 @@ from gateway.goby.portal.context import ProcessContext
 from gateway.goby.portal.errors import ClosedError
 from gateway.goby.portal.interprocess import InterProcessPortal
 from gateway.goby.portal.interthread import InterThreadTransporter
-from util.reactor import Mailbox
+from util.reactor import Reactor, Timer
 
 log = logging.getLogger(__name__)
 
 
 class ThreadTransports:
-    """Everything one thread polls; all methods except ``mailbox.post`` belong to the owning thread."""
+    """Everything one thread waits on, in one ``Reactor``; all methods except ``mailbox.post`` belong to the owner."""
 
     def __init__(self, context: ProcessContext, thread_name: str) -> None:
         self.context = context
         self.thread_name = thread_name
-        self.mailbox = Mailbox(thread_name, ClosedError)
-        self._poller = zmq.Poller()
-        self._poller.register(self.mailbox.fd, zmq.POLLIN)
+        self.reactor = Reactor(thread_name, ClosedError)
+        self.mailbox = self.reactor.mailbox
         self._interthread = InterThreadTransporter(
             context.interthread, self.mailbox, thread_name, context.registry, context.application
         )
         self._interprocess: InterProcessPortal | None = None
+        self._service_timer: Timer | None = None
         self._closed = False
         context.register_closable(self)
 
@@ -47,55 +46,68 @@ class ThreadTransports:
                 raise ClosedError(f"transports of {self.thread_name} are closed")
             portal = InterProcessPortal(self.context, self.mailbox, self.thread_name)
             for sock in portal.pollables():
-                self._poller.register(sock, zmq.POLLIN)
+                self._on_pollable(sock, True)
             portal.on_pollable = self._on_pollable
             self._interprocess = portal
+            self._service_timer = self.reactor.call_later(0.0, self._service)
         return self._interprocess
 
     def _on_pollable(self, sock: zmq.Socket, add: bool) -> None:
         """The portal opened (or closed) a socket of its own, e.g. a manager query after a TCP broker restart."""
         if add:
-            self._poller.register(sock, zmq.POLLIN)
+            portal_handle = self._handle
+            self.reactor.add_reader(sock, lambda: portal_handle(sock))
         else:
-            self._poller.unregister(sock)
+            self.reactor.remove_reader(sock)
+
+    def _handle(self, sock: zmq.Socket) -> None:
+        portal = self._interprocess
+        if portal is not None:
+            portal.handle(sock)
+
+    def _service(self) -> None:
+        portal = self._interprocess
+        if portal is not None:
+            portal.service(time.monotonic())
+            self._arm_service(portal)
+
+    def _arm_service(self, portal: InterProcessPortal) -> None:
+        """Keep one timer at the portal's next deadline (hold requests, probes, re-queries, give-ups)."""
+        deadline = portal.next_deadline()
+        timer = self._service_timer
+        if timer is None:
+            return
+        if deadline is None:
+            timer.cancel()
+        elif not timer.active or timer.deadline != deadline:
+            timer.reschedule(deadline)
 
     @property
     def has_interprocess(self) -> bool:
         return self._interprocess is not None
 
     def poll(self, timeout_s: float | None) -> int:
-        """Wait up to ``timeout_s`` (None: forever) for work, run it on this thread; returns the events handled."""
-        events = self.mailbox.drain() if self.mailbox.pending() else 0
+        """Wait up to ``timeout_s`` (None: until something happens) for work, run it on this thread; returns the
+        events handled."""
         portal = self._interprocess
-        if portal is not None:
-            now = time.monotonic()
-            events += portal.service(now)
-            deadline = portal.next_deadline()
-            if deadline is not None:
-                wait = max(0.0, deadline - now)
-                timeout_s = wait if timeout_s is None else min(timeout_s, wait)
-        if events:
-            timeout_s = 0.0
-        timeout_ms = None if timeout_s is None else math.ceil(timeout_s * 1000)
-        for sock, _ in self._poller.poll(timeout_ms):
-            if sock == self.mailbox.fd:
-                events += self.mailbox.drain()
-            elif portal is not None:
-                events += portal.handle(sock)
-        if portal is not None:
-            events += portal.service(time.monotonic())
-        return events
+        if portal is None:
+            return self.reactor.run_once(timeout_s)
+        # the portal's timed work also runs around every wake-up (a hold released by another thread wakes this
+        # one with no work of its own, only so that it flushes what it buffered)
+        events = portal.service(time.monotonic())
+        self._arm_service(portal)
+        events += self.reactor.run_once(0.0 if events else timeout_s)
+        return events + portal.service(time.monotonic())
 
     def close(self) -> None:
-        """Drop interthread subscriptions, close the portal and the mailbox; idempotent."""
+        """Drop interthread subscriptions, close the portal and the reactor; idempotent."""
         if self._closed:
             return
         self._closed = True
         self._interthread.unsubscribe_all()
         if self._interprocess is not None:
             for sock in self._interprocess.pollables():
-                self._poller.unregister(sock)
+                self.reactor.remove_reader(sock)
             self._interprocess.on_pollable = None
             self._interprocess.close()
-        self._poller.unregister(self.mailbox.fd)
-        self.mailbox.close()
+        self.reactor.close()
