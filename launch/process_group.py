@@ -21,6 +21,7 @@ from pathlib import Path
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import LaunchEntry, expand_vars
 from util.process import ChildProcess, ProcessError
+from util.reactor import Reactor
 
 log = logging.getLogger(__name__)
 
@@ -122,6 +123,7 @@ class ProcessGroup:
         self.processes: list[ManagedProcess] = []
         self.stop_event = threading.Event()
         self._named_once = False
+        self._reactor: Reactor | None = None
 
     # -- start-up -------------------------------------------------------------------------------
 
@@ -230,39 +232,79 @@ class ProcessGroup:
         return process
 
     def supervise(self, status_period_s: float = 5.0, respawn_limit: int = 0) -> int:
-        """Watch the processes until stop_event is set, one dies, or all finish; then stop them all.
+        """Watch the processes until ``request_stop()``, one dies, or all finish; then stop them all.
 
+        Sleeps on a reactor until a child ends (a pidfd per child) or the status line is due: no polling.
         A process that dies is started again (its log appended to) while it has died no more than
         ``respawn_limit`` times; past that, or with the default 0, the others are stopped as goby_launch does.
         Returns the exit status for the launcher: 0 after a requested stop or when every process
         finished cleanly, 1 when a process died for good (named in the report with the tail of its log).
         """
-        next_status = time.monotonic()
-        status = 0
+        reactor = Reactor(f"launch-{self.platform or 'group'}")
+        self._reactor = reactor
+        watched: dict[int, int] = {}  # pid -> pidfd
+        outcome = {"status": 0}
+
+        def watch(process: ManagedProcess) -> None:
+            try:
+                fd = os.pidfd_open(process.pid)
+            except OSError:  # already reaped: the next check() sees it
+                reactor.call_later(0.0, review)
+                return
+            watched[process.pid] = fd
+            reactor.add_reader(fd, review)
+
+        def unwatch_ended() -> None:
+            for process in self.processes:
+                fd = watched.get(process.pid)
+                if fd is not None and not process.running:
+                    reactor.remove_reader(fd)
+                    os.close(fd)
+                    del watched[process.pid]
+
+        def review() -> None:
+            died = self.check()
+            unwatch_ended()
+            if died is not None:
+                stamp = f"[{self.platform}] {time.strftime('%H:%M:%S')}: {died.name} died unexpectedly " \
+                        f"(exit status {died.returncode})"
+                tail = f"Last lines of {died.log_path}:\n{died.log_tail()}"
+                if died.respawns < respawn_limit:
+                    self.report(f"{stamp}; respawning it ({died.respawns + 1} of {respawn_limit}). {tail}")
+                    watch(self.respawn(died))
+                    reactor.call_later(0.0, review)  # another may have died meanwhile
+                    return
+                self.report(f"{stamp}; stopping the others. {tail}")
+                outcome["status"] = 1
+                reactor.stop()
+                return
+            if not self.running():
+                self.report(f"[{self.platform}]: All processes exited")
+                reactor.stop()
+
         try:
-            while not self.stop_event.is_set():
-                died = self.check()
-                if died is not None:
-                    stamp = f"[{self.platform}] {time.strftime('%H:%M:%S')}: {died.name} died unexpectedly " \
-                            f"(exit status {died.returncode})"
-                    tail = f"Last lines of {died.log_path}:\n{died.log_tail()}"
-                    if died.respawns < respawn_limit:
-                        self.report(f"{stamp}; respawning it ({died.respawns + 1} of {respawn_limit}). {tail}")
-                        self.respawn(died)
-                        continue
-                    self.report(f"{stamp}; stopping the others. {tail}")
-                    status = 1
-                    break
-                if not self.running():
-                    self.report(f"[{self.platform}]: All processes exited")
-                    break
-                if time.monotonic() >= next_status:
-                    self._report_status()
-                    next_status = time.monotonic() + status_period_s
-                self.stop_event.wait(POLL_PERIOD_S)
+            for process in self.processes:
+                if process.running:
+                    watch(process)
+            self._report_status()
+            reactor.call_every(status_period_s, self._report_status, align=False)
+            reactor.call_later(0.0, review)
+            if not self.stop_event.is_set():
+                reactor.run(until=self.stop_event.is_set)
         finally:
+            self._reactor = None
+            reactor.close()
+            for fd in watched.values():
+                os.close(fd)
             self.stop()
-        return status
+        return outcome["status"]
+
+    def request_stop(self) -> None:
+        """Ask ``start()``/``supervise()`` to stop everything (thread- and signal-safe)."""
+        self.stop_event.set()
+        reactor = self._reactor
+        if reactor is not None:
+            reactor.stop()
 
     def _report_status(self) -> None:
         stamp = time.strftime("%H:%M:%S")

@@ -118,7 +118,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"Logs in {log_dir}", flush=True)
     def on_signal(signum: int) -> None:
         group.report(f"\nReceived {signal.Signals(signum).name}")
-        group.stop_event.set()
+        group.request_stop()
 
     with handle_signals(on_signal):
         try:
