@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tests.geodesy_reference import ORIGIN, REFERENCE
-from util.geodesy import UTMGeodesy, utm_zone
+from util.geodesy import UTMGeodesy, utm_forward, utm_inverse, utm_zone
 
 FOREST_LAKE = ORIGIN
 
@@ -67,3 +71,24 @@ def test_southern_hemisphere_round_trip() -> None:
 def test_bad_origin_is_refused() -> None:
     with pytest.raises(ValueError, match="origin out of range"):
         UTMGeodesy(95.0, 0.0)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    lat=st.floats(-80.0, 84.0),
+    lon=st.floats(-180.0, 180.0),
+    zone_offset=st.integers(-1, 1),
+)
+def test_our_transverse_mercator_agrees_with_proj(lat: float, lon: float, zone_offset: int) -> None:
+    """Our Krüger series against PROJ (pyproj, a test dependency only), on the point's zone and its neighbours."""
+    pyproj = pytest.importorskip("pyproj")
+    zone = min(60, max(1, utm_zone(lat, lon) + zone_offset))
+    south = lat < 0
+    utm = f"+proj=utm +zone={zone} +ellps=WGS84{' +south' if south else ''}"
+    forward = pyproj.Transformer.from_crs("+proj=latlong +ellps=WGS84", utm, always_xy=True)
+    east, north = forward.transform(lon, lat)
+    ours = utm_forward(lat, lon, zone, south)
+    assert ours[0] == pytest.approx(east, abs=1e-6) and ours[1] == pytest.approx(north, abs=1e-6)
+    back_lat, back_lon = utm_inverse(east, north, zone, south)
+    assert back_lat == pytest.approx(lat, abs=1e-11)
+    assert math.remainder(back_lon - lon, 360.0) == pytest.approx(0.0, abs=1e-11)
