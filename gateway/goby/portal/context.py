@@ -15,16 +15,18 @@ import threading
 import weakref
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import zmq
 
-from gateway.goby.dccl import Codec as DcclCodec
 from gateway.goby.portal.interface_registry import InterfaceRegistry
 from gateway.goby.portal.interthread import InterThread
 from gateway.goby.portal.timeutil import SystemClock
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from util.reactor import Mailbox
+
+if TYPE_CHECKING:
+    from gateway.goby.dccl import Codec as DcclCodec
 
 log = logging.getLogger(__name__)
 
@@ -61,8 +63,7 @@ class ProcessContext:
         self.registry = registry if registry is not None else InterfaceRegistry()
         self.hold_settle_s = hold_settle_s
         self.interthread = InterThread()
-        #: The process's DCCL codec (Goby keeps one per process): DCCL-scheme publications on interprocess.
-        self.dccl = DcclCodec()
+        self._dccl: DcclCodec | None = None
         self.ready_flag = False
         self._hold_released = threading.Event()
         self._primary_claimed = False
@@ -71,6 +72,20 @@ class ProcessContext:
         self._lock = threading.Lock()
         self._zmq: zmq.Context | None = None
         self._closed = False
+
+    @property
+    def dccl(self) -> DcclCodec:
+        """The process's DCCL codec (Goby keeps one per process), made on first use: a process that never meets a
+        DCCL message does not pay for the codec's imports (2.6 MiB)."""
+        codec = self._dccl
+        if codec is None:
+            with self._lock:
+                if self._dccl is None:
+                    from gateway.goby.dccl import Codec
+
+                    self._dccl = Codec()
+                codec = self._dccl
+        return codec
 
     @property
     def zmq_context(self) -> zmq.Context:

@@ -12,12 +12,14 @@ import logging
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from gateway.goby.dccl import Codec as DcclCodec
 from gateway.goby.portal.errors import IdentifierError, MarshallingError
 from gateway.goby.portal.identifier import Identifier, decode_frame
 from gateway.goby.portal.marshalling import Scheme, parse
+
+if TYPE_CHECKING:
+    from gateway.goby.dccl import Codec as DcclCodec
 
 HEAD_CACHE_SIZE = 4096  # distinct identifiers remembered as already validated
 
@@ -44,7 +46,7 @@ class RegexSubscription:
 class FrameDispatcher:
     """Typed subscriptions by prefix (``subs``), regex ones (``regex``), and the frames that fit neither."""
 
-    def __init__(self, thread_name: str, pid: int, dccl: DcclCodec, log: logging.Logger) -> None:
+    def __init__(self, thread_name: str, pid: int, dccl: Callable[[], DcclCodec], log: logging.Logger) -> None:
         self._thread_name = thread_name
         self._pid = pid
         self._dccl = dccl
@@ -88,7 +90,7 @@ class FrameDispatcher:
                 msg = parsed.get(sub.msg_type)
                 if msg is None:
                     try:
-                        msg = parse(payload, sub.scheme, sub.msg_type, self._dccl)
+                        msg = parse(payload, sub.scheme, sub.msg_type, self._dccl() if sub.scheme == Scheme.DCCL else None)
                     except MarshallingError as exc:
                         self._log.error("%s: cannot decode publication on %s (%s): %s", self._thread_name,
                                         ident.group, ident.type_name, exc)

@@ -48,6 +48,7 @@ from gateway.goby.portal.marshalling import (
     serialize,
     type_name,
 )
+from gateway.goby.portal.monitor_events import recv_monitor_event
 from gateway.goby.portal.subscription_evidence import LIVE, MISSING, RESUBSCRIBE_WAIT_S, SubscriptionEvidence
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from gateway.goby.protobuf.interprocess_zeromq_pb2 import ManagerResponse
@@ -73,7 +74,7 @@ class InterProcessPortal:
         self._pid = os.getpid()
         self._thread_hex = thread_id()
         self._owner = threading.get_ident()
-        self._frames = FrameDispatcher(thread_name, self._pid, context.dccl, log)
+        self._frames = FrameDispatcher(thread_name, self._pid, lambda: context.dccl, log)
         self._subs = self._frames.subs
         self._regex = self._frames.regex
         self._held: deque[bytes] = deque()
@@ -133,7 +134,7 @@ class InterProcessPortal:
         self._check_open()
         group_text = self._group_text(group)
         sch, tname, key = self._type_info(type(msg), scheme)
-        sent = self._publish_frame(group_text, sch, tname, serialize(msg, sch, self._ctx.dccl), record)
+        sent = self._publish_frame(group_text, sch, tname, serialize(msg, sch, self._ctx.dccl if sch == Scheme.DCCL else None), record)
         self._ctx.interthread.deliver(group_text, key, msg, self._mailbox)
         return sent
 
@@ -447,16 +448,16 @@ class InterProcessPortal:
         self._frames.deliver(ident, prefix, payload)
 
     def _handle_monitor(self) -> int:
-        from zmq.utils.monitor import recv_monitor_message
-
         count = 0
         while True:
             try:
-                event = recv_monitor_message(self._monitor, zmq.NOBLOCK)
+                event = recv_monitor_event(self._monitor, zmq.NOBLOCK)
             except zmq.Again:
                 return count
             count += 1
-            kind = event["event"]
+            if event is None:
+                continue
+            kind = event.event
             if kind == zmq.EVENT_DISCONNECTED and not self._disconnected:
                 self._disconnected = True
                 self._topics.connection_lost()

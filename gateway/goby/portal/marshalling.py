@@ -10,14 +10,15 @@ use as Goby's does.
 from __future__ import annotations
 
 import enum
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from google.protobuf import message as pb_message
 from google.protobuf import message_factory, symbol_database
 
-from gateway.goby.dccl import Codec as DcclCodec
-from gateway.goby.dccl import DcclError
 from gateway.goby.portal.errors import MarshallingError
+
+if TYPE_CHECKING:
+    from gateway.goby.dccl import Codec as DcclCodec
 
 
 class Scheme(enum.IntEnum):
@@ -92,6 +93,8 @@ def type_name(msg_type: type, scheme: int) -> str:
 def serialize(msg: Any, scheme: int, dccl: DcclCodec | None = None) -> bytes:
     """Encode ``msg`` for the wire under ``scheme`` (DCCL needs the process's codec, ``dccl``)."""
     if scheme == Scheme.DCCL and isinstance(msg, pb_message.Message) and dccl is not None:
+        from gateway.goby.dccl import DcclError
+
         try:
             dccl.load(type(msg))
             return dccl.encode(msg)
@@ -123,6 +126,8 @@ def parse(data: bytes, scheme: int, msg_type: type, dccl: DcclCodec | None = Non
         if scheme == Scheme.DCCL:
             if dccl is None:
                 raise MarshallingError(f"no DCCL codec to decode {msg_type.DESCRIPTOR.full_name} with")
+            from gateway.goby.dccl import DcclError
+
             try:
                 dccl.load(msg_type)
                 return dccl.decode(data, msg_type)
