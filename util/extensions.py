@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import hashlib
 import importlib
-import importlib.metadata
 import importlib.util
 import re
 import sys
@@ -30,7 +29,10 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType, ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import importlib.metadata
 
 _SHARED_LIBRARY = re.compile(r"lib(?P<stem>.+?)\.so(?:\.[0-9.]*)?")
 
@@ -62,7 +64,12 @@ class ExtensionPoint:
     entry_points_only: bool = False
 
     def entry_points(self) -> dict[str, importlib.metadata.EntryPoint]:
-        """Installed entry points of the group, by name (read afresh: packages may be installed at run time)."""
+        """Installed entry points of the group, by name (read afresh: packages may be installed at run time).
+
+        ``importlib.metadata`` is imported here, not at the top: it pulls the email package (1.8 MiB private) into
+        every process, most of which never load an extension."""
+        import importlib.metadata
+
         return {ep.name: ep for ep in importlib.metadata.entry_points(group=self.group)}
 
     def names(self) -> list[str]:
