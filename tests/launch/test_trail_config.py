@@ -3,6 +3,7 @@ are the course's, bad input fails the course's way, MOOS files come and go with 
 
 from __future__ import annotations
 
+import os
 import re
 import signal
 import subprocess
@@ -187,8 +188,11 @@ def test_moos_gen_writes_the_files_and_removes_them_on_sigterm(tmp_path):
     try:
         assert proc.stdout.readline().startswith("wrote ")
         assert (tmp_path / "auv1.moos").is_file() and (tmp_path / "auv1.bhv").is_file()
+        # it waits as the course's script does, in a shell, not in a Python interpreter for the whole mission
+        assert os.path.basename(os.path.realpath(f"/proc/{proc.pid}/exe")) in ("dash", "bash", "sh")
         proc.send_signal(signal.SIGTERM)
         assert proc.wait(timeout=30) == 0
+        assert proc.stdout.readline().startswith("removed ")
     finally:
         if proc.poll() is None:
             proc.kill()
