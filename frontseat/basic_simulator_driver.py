@@ -8,6 +8,9 @@ kept out of Goby's message so that Goby-only config files work with both drivers
 Unlike Goby's driver, this one notices a lost link (the frontseat becomes NOT_CONNECTED) and, on every new
 connection, sends START again, so a restarted simulator brings the interface from FS_ERROR back to
 STANDBY and on to COMMAND.
+
+The link is a :class:`~frontseat.line_client.LineConnection` on the host's reactor: every line is handled when it
+arrives (a NAV fix is emitted as data at once); :meth:`BasicSimulatorDriver.loop` only checks the data timeout.
 """
 
 from __future__ import annotations
@@ -17,12 +20,13 @@ import math
 
 from frontseat.driver import Clock, FrontSeatDriver
 from frontseat.errors import DriverConfigError, SimulatorLineError
-from frontseat.line_client import LineClient
+from frontseat.line_client import LineConnection
 from frontseat.protobuf import basic_simulator_config_pb2 as sim_pb
 from frontseat.protobuf import basic_simulator_tuning_pb2 as tuning_pb
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_pb2 as fs_pb
 from frontseat.simulator import protocol
+from util.reactor import Reactor
 
 log = logging.getLogger(__name__)
 
@@ -41,8 +45,8 @@ def frontseat_driver_load(cfg: config_pb.Config) -> FrontSeatDriver:
 class BasicSimulatorDriver(FrontSeatDriver):
     """Talks START/CMD to the simulator and turns its CTRL/NAV/CMD lines into states, data and responses."""
 
-    def __init__(self, cfg: config_pb.Config, *, clock: Clock | None = None) -> None:
-        super().__init__(cfg, clock=clock)
+    def __init__(self, cfg: config_pb.Config, *, clock: Clock | None = None, reactor: Reactor | None = None) -> None:
+        super().__init__(cfg, clock=clock, reactor=reactor)
         if not cfg.HasExtension(CONFIG_EXTENSION):
             raise DriverConfigError(f"frontseat_cfg has no [{EXTENSION_NAME}] block; the basic simulator driver needs one")
         self.sim_cfg = sim_pb.BasicSimulatorFrontSeatConfig()
@@ -56,16 +60,19 @@ class BasicSimulatorDriver(FrontSeatDriver):
         self._providing_data = False
         self._last_data_time = -math.inf
         self._last_request = fs_pb.CommandRequest()
-        self._seen_connection = 0
-        self._link = LineClient(
+        self._link = LineConnection(
+            self.reactor,
             self.sim_cfg.tcp_address,
             self.sim_cfg.tcp_port,
+            on_line=self._on_line,
+            on_connect=self._on_connect,
+            on_disconnect=self._on_disconnect,
             reconnect_interval=self.tuning.reconnect_interval,
             name="frontseat-basic-sim-link",
         ).start()
 
     def close(self) -> None:
-        """Disconnect from the simulator and stop the link thread. Idempotent."""
+        """Disconnect from the simulator and stop reconnecting. Idempotent."""
         self._link.close()
 
     # ----- the six driver methods -------------------------------------------------------------------------
@@ -91,27 +98,27 @@ class BasicSimulatorDriver(FrontSeatDriver):
         self._write(text[:-2] if text.endswith("\r\n") else text)
 
     def loop(self) -> None:
-        self._check_connection()
-        for line in self._link.read_lines():
-            self._process_line(line.strip())
+        """The tick: only the data timeout (lines are handled on arrival, by the link's callbacks)."""
         if self.now() > self._last_data_time + self.tuning.data_timeout:
             if self._providing_data:
                 log.warning("no NAV from the simulator for %.1f s", self.tuning.data_timeout)
             self._providing_data = False
 
-    # ----- internals --------------------------------------------------------------------------------------
-    def _check_connection(self) -> None:
-        connection_id, connected = self._link.connection_id, self._link.connected
-        if connection_id != self._seen_connection and connected:
-            self._seen_connection = connection_id
-            log.info("connected to the basic vehicle simulator at %s", self._link.address)
-            self._fs_state = fs_pb.FRONTSEAT_IDLE
-            self._write(self._start_line())
-        elif not connected and self._fs_state != fs_pb.FRONTSEAT_NOT_CONNECTED:
-            log.warning("connection to the frontseat at %s lost", self._link.address)
-            self._fs_state = fs_pb.FRONTSEAT_NOT_CONNECTED
-            self._providing_data = False
+    # ----- the link's callbacks (the host's main thread) ----------------------------------------------------
+    def _on_connect(self) -> None:
+        log.info("connected to the basic vehicle simulator at %s", self._link.address)
+        self._fs_state = fs_pb.FRONTSEAT_IDLE
+        self._write(self._start_line())
 
+    def _on_disconnect(self) -> None:
+        log.warning("connection to the frontseat at %s lost", self._link.address)
+        self._fs_state = fs_pb.FRONTSEAT_NOT_CONNECTED
+        self._providing_data = False
+
+    def _on_line(self, line: str) -> None:
+        self._process_line(line.strip())
+
+    # ----- internals --------------------------------------------------------------------------------------
     def _start_line(self) -> str:
         start = self.sim_cfg.start
         return protocol.start_line(
@@ -129,7 +136,8 @@ class BasicSimulatorDriver(FrontSeatDriver):
         if self._link.write_line(line):
             self.signal_raw_to_frontseat.emit(fs_pb.Raw(raw=line.encode()))
         else:
-            log.warning("not connected to the frontseat at %s; dropped %r", self._link.address, line)
+            log.warning("could not send to the frontseat at %s (%s); dropped %r", self._link.address,
+                        "not connected" if not self._link.connected else "over the output bound", line)
 
     def _process_line(self, line: str) -> None:
         self.signal_raw_from_frontseat.emit(fs_pb.Raw(raw=line.encode()))
@@ -164,6 +172,5 @@ class BasicSimulatorDriver(FrontSeatDriver):
         status.global_fix.lat = protocol.as_double(fields.get("LAT"))
         self.compute_missing(status)
         self.signal_data_from_frontseat.emit(data)
-        if self._fs_state != fs_pb.FRONTSEAT_NOT_CONNECTED:  # not a stale line read after the link dropped
-            self._providing_data = True
-            self._last_data_time = self.now()
+        self._providing_data = True
+        self._last_data_time = self.now()

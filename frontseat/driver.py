@@ -7,9 +7,11 @@ machine of Goby3's ``InterfaceBase`` (see docs/frontseat.md):
 * :meth:`do_work` is one tick: check for a state change (at most one transition), then call :meth:`loop`.
 * Timeouts count from construction, in the clock's (possibly warped) seconds.
 * A driver's :meth:`loop` may raise :class:`HelmErrorException` / :class:`FrontSeatErrorException`.
+* A driver does its I/O on :attr:`FrontSeatDriver.reactor`, the host's event loop: it registers its sockets there
+  and handles what arrives when it arrives (a NAV fix is emitted at once, not at the next tick).
 
 Threading: a driver object is not thread-safe. The host calls every public method, and the driver emits
-every signal, on one thread (the interface's main thread).
+every signal, on one thread (the interface's main thread, whose reactor the driver's I/O runs on).
 """
 
 from __future__ import annotations
@@ -17,6 +19,9 @@ from __future__ import annotations
 import abc
 import logging
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Protocol
 
 from frontseat import seawater
@@ -27,6 +32,7 @@ from frontseat.protobuf import frontseat_pb2 as fs_pb
 from frontseat.signals import Signal
 from gateway.goby.protobuf import geographic_pb2 as geo_pb
 from util.geodesy import UTMGeodesy
+from util.reactor import Reactor
 
 log = logging.getLogger(__name__)
 raw_in_log = logging.getLogger("frontseat.raw.in")
@@ -37,6 +43,19 @@ class Clock(Protocol):
     """Anything with ``now()`` in seconds: the hosting application's warped clock, a fake in tests."""
 
     def now(self) -> float: ...
+
+
+_HOST_REACTOR: ContextVar[Reactor | None] = ContextVar("frontseat_host_reactor", default=None)
+
+
+@contextmanager
+def hosted_on(reactor: Reactor) -> Iterator[Reactor]:
+    """Drivers constructed inside the block do their I/O on ``reactor`` (the host's event loop)."""
+    token = _HOST_REACTOR.set(reactor)
+    try:
+        yield reactor
+    finally:
+        _HOST_REACTOR.reset(token)
 
 
 def _application_clock() -> Clock:
@@ -53,16 +72,18 @@ def _application_clock() -> Clock:
 class FrontSeatDriver(abc.ABC):
     """Base class of every frontseat driver (Goby's ``InterfaceBase``).
 
-    Signals (emitted by the driver from :meth:`loop`, on the host's main thread):
+    Signals (emitted by the driver from :meth:`loop` or from its I/O callbacks on :attr:`reactor`, on the host's
+    main thread):
     ``signal_command_response(CommandResponse)``, ``signal_data_from_frontseat(InterfaceData)``,
     ``signal_raw_from_frontseat(Raw)``, ``signal_raw_to_frontseat(Raw)``; and, emitted by the base class,
     ``signal_state_change(InterfaceState)`` after every transition (and on every error raised).
     """
 
-    def __init__(self, cfg: config_pb.Config, *, clock: Clock | None = None) -> None:
+    def __init__(self, cfg: config_pb.Config, *, clock: Clock | None = None, reactor: Reactor | None = None) -> None:
         self._cfg = config_pb.Config()
         self._cfg.CopyFrom(cfg)
         self._clock: Clock = clock if clock is not None else _application_clock()
+        self._reactor = reactor if reactor is not None else _HOST_REACTOR.get()
 
         self.signal_command_response: Signal[fs_pb.CommandResponse] = Signal("command_response")
         self.signal_data_from_frontseat: Signal[fs_pb.InterfaceData] = Signal("data_from_frontseat")
@@ -116,6 +137,20 @@ class FrontSeatDriver(abc.ABC):
         self.close()
 
     # ----- host API ---------------------------------------------------------------------------------------
+    @property
+    def reactor(self) -> Reactor:
+        """The host's event loop, for the driver's sockets and timers (its callbacks run on the host's main thread).
+
+        Given to the constructor, or by the host constructing the driver inside :func:`hosted_on` (the interface
+        does); a :class:`DriverConfigError` if neither.
+        """
+        if self._reactor is None:
+            raise DriverConfigError(
+                f"{type(self).__name__} does its I/O on its host's reactor: construct it with reactor=... "
+                "or inside frontseat.driver.hosted_on(reactor)"
+            )
+        return self._reactor
+
     def cfg(self) -> config_pb.Config:
         """The driver's configuration (a copy owned by the driver; treat as read-only)."""
         return self._cfg

@@ -1,11 +1,14 @@
 """The goby_frontseat_interface application (console script ``frontseat-interface``, ``frontseat.apps.frontseat_interface``).
 
-It loads one driver (``FRONTSEAT_DRIVER_LIBRARY``), ticks it at 10 Hz times warp on the main thread, and
-bridges it to the interprocess portal with Goby's groups and state gating: commands reach the frontseat
-only in COMMAND, data and raw in LISTEN or COMMAND. Status goes out every ``status_period`` (simulated)
-seconds. With a ``[goby.moos.protobuf.moos_helm]`` block it also runs the MOOS helm interface thread (found by
-entry point ``moos_helm``: the translators' FrontSeatTranslation), which connects pHelmIvP (or any MOOS helm)
-through a MOOSDB.
+It loads one driver (``FRONTSEAT_DRIVER_LIBRARY``), whose I/O runs on the main thread's reactor, ticks it at
+10 Hz times warp (Goby's loop: the state machine and the driver's timeouts), and bridges it to the portal with
+Goby's groups and state gating: commands reach the frontseat only in COMMAND, data and raw in LISTEN or COMMAND.
+Data does not wait for the tick: a fix the driver reads is published as it arrives. Status goes out every
+``status_period`` (simulated) seconds. With a ``[goby.moos.protobuf.moos_helm]`` block it also runs the MOOS helm
+interface thread (found by entry point ``moos_helm``: the translators' FrontSeatTranslation), which connects
+pHelmIvP (or any MOOS helm) through a MOOSDB; as Goby's threads, it takes ``node_status`` from this thread and gives
+``helm_state``/``desired_course`` to it by interthread (all three are still published interprocess, as in Goby), and
+this thread then takes those two from it only.
 
 Threading: every subscription callback, the driver's signals and the driver itself run on the main thread.
 """
@@ -15,7 +18,7 @@ from __future__ import annotations
 import logging
 
 from frontseat import groups
-from frontseat.driver import FrontSeatDriver
+from frontseat.driver import FrontSeatDriver, hosted_on
 from frontseat.errors import FrontSeatException
 from frontseat.loading import DriverFactory, helm_interface_class
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
@@ -59,13 +62,17 @@ def helm_gateway_config(cfg: app_pb.FrontSeatInterfaceConfig) -> gateway_pb.Goby
 class FrontSeatInterface(MultiThreadApplication):
     """The interface application: one driver, the portal, and optionally the MOOS helm thread."""
 
-    def __init__(self, cfg: app_pb.FrontSeatInterfaceConfig, driver_factory: DriverFactory) -> None:
-        super().__init__(cfg, LOOP_FREQUENCY_HZ)
+    def __init__(self, cfg: app_pb.FrontSeatInterfaceConfig, driver_factory: DriverFactory, *,
+                 loop_frequency_hz: float = LOOP_FREQUENCY_HZ) -> None:
+        """``loop_frequency_hz`` (times warp) is Goby's 10 Hz; tests slow it to show that data does not wait for it."""
+        super().__init__(cfg, loop_frequency_hz)
         self._next_status: float | None = None
         self._last_failure = ""
         self._last_helm_report: float | None = None
+        self._helm_embedded = helm_gateway_config(cfg) is not None
         try:
-            with use_context(self.context):  # the driver's default clock is this application's clock
+            # the driver's default clock is this application's clock; its I/O runs on this thread's reactor
+            with use_context(self.context), hosted_on(self.reactor):
                 self._driver: FrontSeatDriver = driver_factory(driver_config(cfg))
             self._connect_driver()
             self._subscribe()
@@ -85,7 +92,7 @@ class FrontSeatInterface(MultiThreadApplication):
         self._driver.signal_raw_from_frontseat.connect(self._on_raw_from_frontseat)
         self._driver.signal_raw_to_frontseat.connect(self._on_raw_to_frontseat)
 
-    # ----- driver signals (main thread, inside do_work) --------------------------------------------------
+    # ----- driver signals (main thread: in do_work, or as the driver's I/O arrives) ------------------------
     def _on_command_response(self, response: fs_pb.CommandResponse) -> None:
         self.interprocess().publish(groups.command_response, response)
 
@@ -103,9 +110,16 @@ class FrontSeatInterface(MultiThreadApplication):
 
     def _subscribe(self) -> None:
         portal = self.interprocess()
-        portal.subscribe(groups.helm_state, fs_pb.HelmStateReport, self._on_helm_state)
+        # The helm's reports and setpoints: from the embedded MOOS helm interface thread by interthread (they never
+        # leave the process to come back; it still publishes them interprocess for other processes, as in Goby),
+        # else from whichever process runs the helm, through the broker.
+        if self._helm_embedded:
+            self.interthread().subscribe(groups.helm_state, fs_pb.HelmStateReport, self._on_helm_state)
+            self.interthread().subscribe(groups.desired_course, data_pb.DesiredCourse, self._on_desired_course)
+        else:
+            portal.subscribe(groups.helm_state, fs_pb.HelmStateReport, self._on_helm_state)
+            portal.subscribe(groups.desired_course, data_pb.DesiredCourse, self._on_desired_course)
         portal.subscribe(groups.command_request, fs_pb.CommandRequest, self._on_command_request)
-        portal.subscribe(groups.desired_course, data_pb.DesiredCourse, self._on_desired_course)
         portal.subscribe(groups.data_to_frontseat, fs_pb.InterfaceData, self._on_data_to_frontseat)
         portal.subscribe(groups.raw_send_request, fs_pb.Raw, self._on_raw_send_request)
         portal.subscribe(groups.datum_update, nav_pb.DatumUpdate, self._on_datum_update)
@@ -117,7 +131,7 @@ class FrontSeatInterface(MultiThreadApplication):
         helm_interface = helm_interface_class()  # ExtensionError if not installed: one line, exit 1
         log.info("launching the MOOS helm interface thread %s (MOOSDB %s:%d)", helm_interface.__qualname__,
                  gateway_cfg.moos.server, gateway_cfg.moos.port)
-        self.launch_thread(helm_interface, gateway_cfg)
+        self.launch_thread(helm_interface, gateway_cfg, embedded=True)
 
     # ----- subscriptions (main thread) -------------------------------------------------------------------
     def _on_helm_state(self, report: fs_pb.HelmStateReport) -> None:
@@ -197,11 +211,14 @@ class FrontSeatInterface(MultiThreadApplication):
         self.interprocess().publish(groups.status, status)
 
     def close(self) -> None:
-        """Join the helm thread, close the portal, then the driver; idempotent."""
-        super().close()
+        """Close the driver (its sockets leave this thread's reactor), join the helm thread, close the portal;
+        idempotent."""
         driver = getattr(self, "_driver", None)  # absent if the driver factory raised
-        if driver is not None:
-            driver.close()
+        try:
+            if driver is not None:
+                driver.close()
+        finally:
+            super().close()
 
 
 def example_config(driver_module: object | None = None) -> str:

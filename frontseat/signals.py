@@ -1,7 +1,7 @@
 """A minimal signal (boost::signals2 style): drivers emit, the host application connects.
 
 Slots run synchronously on the thread that calls :meth:`Signal.emit` (for drivers: the interface's main
-thread, inside ``loop()``). A slot that raises is logged and the remaining slots still run, so one broken
+thread, in ``loop()`` or in the driver's I/O callbacks on that thread's reactor). A slot that raises is logged and the remaining slots still run, so one broken
 subscriber cannot stop the others from hearing from the frontseat.
 """
 

@@ -160,3 +160,11 @@ def test_an_idle_reactor_uses_no_cpu(reactor: Reactor) -> None:
     while time.monotonic() < end:
         reactor.run_once()
     assert time.thread_time() - before < 0.02
+
+
+def test_a_timer_weeks_away_does_not_overflow_the_poll(reactor: Reactor) -> None:
+    reactor.call_later(60 * 86400.0, lambda: None)
+    reactor.post(lambda: None)
+    assert reactor.run_once() == 1  # the posted work ran; the far timer did not break the poll
+    reactor.wake()
+    reactor.run_once()

@@ -31,6 +31,7 @@ log = logging.getLogger(__name__)
 
 READ = zmq.POLLIN
 WRITE = zmq.POLLOUT
+MAX_WAIT_S = 3600.0
 
 
 class ReactorClosedError(RuntimeError):
@@ -41,11 +42,11 @@ class _HasFileno(Protocol):
     def fileno(self) -> int: ...
 
 
-Source = zmq.Socket | int | _HasFileno  # type: ignore[type-arg]
+Source = zmq.Socket | int | _HasFileno
 Handler = Callable[[], object]
 
 
-def _key(source: Source) -> zmq.Socket | int:  # type: ignore[type-arg]
+def _key(source: Source) -> zmq.Socket | int:
     """What the poller reports a source as: the zmq socket itself, else its descriptor number."""
     if isinstance(source, (zmq.Socket, int)):
         return source
@@ -211,7 +212,7 @@ class Reactor:
         if self._writers.pop(key, None) is not None:
             self._set_mask(key, self._masks.get(key, 0) & ~WRITE)
 
-    def _set_mask(self, source: zmq.Socket | int, mask: int) -> None:  # type: ignore[type-arg]
+    def _set_mask(self, source: zmq.Socket | int, mask: int) -> None:
         if mask:
             self._masks[source] = mask
             self._poller.register(source, mask)
@@ -234,7 +235,7 @@ class Reactor:
         ``align`` puts the ticks on multiples of the period of the monotonic clock, as Goby's loop does; a tick
         that falls behind is skipped, never burst.  A period that becomes 0 or infinite stops the timer.
         """
-        period = period_s if callable(period_s) else (lambda: float(period_s))  # type: ignore[misc]
+        period = period_s if callable(period_s) else (lambda: float(period_s))
         first = period()
         if not (first > 0 and math.isfinite(first)):
             raise ValueError(f"timer period must be finite and > 0, got {first!r}")
@@ -299,7 +300,8 @@ class Reactor:
         if deadline is not None:
             wait = max(0.0, deadline - time.monotonic())
             timeout_s = wait if timeout_s is None else min(timeout_s, wait)
-        timeout_ms = None if timeout_s is None else math.ceil(timeout_s * 1000)
+        # poll(2) takes an int of milliseconds: a timer weeks away waits in hour-long naps instead of overflowing
+        timeout_ms = None if timeout_s is None else math.ceil(min(timeout_s, MAX_WAIT_S) * 1000)
         for source, ready in self._poller.poll(timeout_ms):
             if source == self.mailbox.fd:
                 events += self.mailbox.drain()

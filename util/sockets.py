@@ -1,4 +1,4 @@
-"""Small socket helpers shared by the selector-driven servers (the MOOSDB and the frontseat simulator)."""
+"""Small socket helpers shared by the reactor-driven servers (the MOOSDB and the frontseat simulator)."""
 
 from __future__ import annotations
 

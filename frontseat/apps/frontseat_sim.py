@@ -36,12 +36,13 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:
         print(f"frontseat-sim: cannot listen on {args.host}:{port}: {exc}", file=sys.stderr)
         return 1
-    with handle_signals() as done, server:
+    with handle_signals(lambda _signum: server.stop()):
         print(f"frontseat-sim listening on {server.host}:{server.port}", flush=True)
-        while not done.wait(0.5):
-            if not server.running:
-                print("server failed...", file=sys.stderr)
-                return 1
+        try:
+            server.run()  # on this thread, until a signal stops it
+        except Exception as exc:  # logged with its traceback by the server
+            print(f"frontseat-sim: server failed: {exc}", file=sys.stderr)
+            return 1
     return 0
 
 

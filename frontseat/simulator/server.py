@@ -1,30 +1,30 @@
 """The simulator's TCP server (goby_basic_frontseat_simulator; console script ``frontseat.apps.frontseat_sim``).
 
-One thread does everything with ``selectors``: it accepts clients, splits their bytes into ``\\r\\n`` lines,
-and every ``1/(FREQ*WARP)`` real seconds feeds the lines received since the last tick to the
-:class:`~frontseat.simulator.model.Simulation` and writes replies and NAV to every client (as Goby's
-``TCPServer::write`` with no destination does). A client can never take the server down: over-long lines,
-garbage and abrupt disconnects are logged and dropped; a client that stops reading is disconnected.
+One thread does everything on one :class:`~util.reactor.Reactor`: it accepts clients and splits their bytes into
+``\\r\\n`` lines as they arrive, and a timer every ``1/(FREQ*WARP)`` real seconds feeds the lines received since
+the last tick to the :class:`~frontseat.simulator.model.Simulation` and writes replies and NAV to every client (as
+Goby's ``TCPServer::write`` with no destination does).  The timer runs only while the simulation is started or
+lines wait, so an idle simulator sleeps.  A client can never take the server down: over-long lines, garbage and
+abrupt disconnects are logged and dropped; a client that stops reading is disconnected.
 """
 
 from __future__ import annotations
 
 import logging
-import selectors
 import socket
 import threading
-import time
 from dataclasses import dataclass, field
 
 from frontseat.simulator.model import Simulation
 from frontseat.simulator.protocol import LineSplitter, encode_lines
+from util.reactor import Reactor, Timer
 from util.sockets import accept_client
 
 log = logging.getLogger(__name__)
 
 MAX_LINE = 64 * 1024  # bytes; longer lines are discarded (with an error logged)
 MAX_BACKLOG = 1024 * 1024  # bytes queued for a client that is not reading before we drop it
-MAX_LAG = 1.0  # seconds behind schedule before the tick clock is reset instead of catching up
+RECV_SIZE = 65536
 
 
 @dataclass
@@ -38,7 +38,9 @@ class _Client:
 class SimulatorServer:
     """The basic frontseat simulator on ``host:port`` (``port=0`` picks a free one; read :attr:`port`).
 
-    Use as a context manager or call :meth:`start` / :meth:`stop`; the server runs on its own thread.
+    Either :meth:`run` it on the calling thread until :meth:`stop` (the console script), or :meth:`start` it on a
+    thread of its own named ``frontseat-sim`` (tests); a context manager starts and stops it.  Only :meth:`stop`
+    may be called from another thread (or a signal handler).
     """
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0, simulation: Simulation | None = None) -> None:
@@ -46,36 +48,49 @@ class SimulatorServer:
         self._listener = socket.create_server((host, port), reuse_port=False)
         self._listener.setblocking(False)
         self.host, self.port = self._listener.getsockname()[:2]
-        self._selector = selectors.DefaultSelector()
-        self._wake_r, self._wake_w = socket.socketpair()
-        self._wake_r.setblocking(False)
+        self._reactor = Reactor("frontseat-sim")
         self._clients: dict[socket.socket, _Client] = {}
         self._pending: list[str] = []
+        self._tick_timer: Timer | None = None
         self._stopping = threading.Event()
+        self._serving = False
         self._thread: threading.Thread | None = None
         self._closed = False
 
     # ----- lifecycle --------------------------------------------------------------------------------------
     def start(self) -> SimulatorServer:
-        """Start serving on a background thread named ``frontseat-sim``."""
-        if self._thread is not None:
-            return self
-        self._thread = threading.Thread(target=self._serve, name="frontseat-sim", daemon=True)
-        self._thread.start()
-        log.info("basic frontseat simulator listening on %s:%d", self.host, self.port)
+        """Serve on a background thread named ``frontseat-sim`` (idempotent)."""
+        if self._thread is None:
+            self._thread = threading.Thread(target=self.run, name="frontseat-sim", daemon=True)
+            self._serving = True  # from now on, running is true until the thread ends
+            self._thread.start()
         return self
 
-    def stop(self) -> None:
-        """Stop serving, disconnect every client and close the listening socket. Idempotent."""
-        self._stopping.set()
+    def run(self) -> None:
+        """Serve on the calling thread until :meth:`stop`; then disconnect every client and close the listener."""
+        self._serving = True
+        log.info("basic frontseat simulator listening on %s:%d", self.host, self.port)
         try:
-            self._wake_w.send(b"x")
-        except OSError:
-            pass
-        if self._thread is not None and self._thread is not threading.current_thread():
-            self._thread.join(timeout=10)
-        if self._thread is None or not self._thread.is_alive():
+            if not self._stopping.is_set():
+                self._reactor.add_reader(self._listener, self._accept)
+                self._reactor.run(until=self._stopping.is_set)
+        except Exception:  # pragma: no cover - a bug; say so loudly rather than hang silently
+            log.exception("simulator server loop failed")
+            raise
+        finally:
+            self._serving = False
             self._close_all()
+
+    def stop(self) -> None:
+        """Stop serving, disconnect every client and close the listening socket. Idempotent; thread-safe."""
+        self._stopping.set()
+        self._reactor.stop()
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout=10)
+        if thread is None or not thread.is_alive():
+            if not self._serving:
+                self._close_all()
 
     def __enter__(self) -> SimulatorServer:
         return self.start()
@@ -85,51 +100,15 @@ class SimulatorServer:
 
     @property
     def running(self) -> bool:
-        """True while the serving thread is alive."""
-        return self._thread is not None and self._thread.is_alive()
+        """True while the server is serving (on its own thread or in :meth:`run`)."""
+        thread = self._thread
+        return self._serving and (thread is None or thread.is_alive())
 
     @property
     def client_count(self) -> int:
         return len(self._clients)
 
-    # ----- the loop ---------------------------------------------------------------------------------------
-    def _serve(self) -> None:
-        self._selector.register(self._listener, selectors.EVENT_READ, "accept")
-        self._selector.register(self._wake_r, selectors.EVENT_READ, "wake")
-        next_tick = time.monotonic()
-        try:
-            while not self._stopping.is_set():
-                timeout = max(0.0, next_tick - time.monotonic())
-                for key, events in self._selector.select(timeout):
-                    self._on_event(key, events)
-                now = time.monotonic()
-                if now >= next_tick:
-                    self._tick()
-                    next_tick += self.simulation.period
-                    if now - next_tick > MAX_LAG:
-                        log.warning("simulator fell %.1f s behind schedule; skipping ahead", now - next_tick)
-                        next_tick = now
-        except Exception:  # pragma: no cover - a bug; say so loudly rather than hang silently
-            log.exception("simulator server loop failed")
-            raise
-        finally:
-            self._close_all()
-
-    def _on_event(self, key: selectors.SelectorKey, events: int) -> None:
-        if key.data == "accept":
-            self._accept()
-        elif key.data == "wake":
-            try:
-                self._wake_r.recv(4096)
-            except OSError:
-                pass
-        else:
-            client = key.data
-            if events & selectors.EVENT_READ:
-                self._read(client)
-            if events & selectors.EVENT_WRITE and client.sock in self._clients:
-                self._flush(client)
-
+    # ----- sockets (the serving thread) -------------------------------------------------------------------
     def _accept(self) -> None:
         accepted = accept_client(self._listener)
         if accepted is None:
@@ -137,12 +116,12 @@ class SimulatorServer:
         sock, peer = accepted
         client = _Client(sock, peer)
         self._clients[sock] = client
-        self._selector.register(sock, selectors.EVENT_READ, client)
+        self._reactor.add_reader(sock, lambda: self._read(client))
         log.info("client %s connected (%d connected)", client.peer, len(self._clients))
 
     def _read(self, client: _Client) -> None:
         try:
-            data = client.sock.recv(65536)
+            data = client.sock.recv(RECV_SIZE)
         except (BlockingIOError, InterruptedError):
             return
         except OSError as exc:
@@ -151,10 +130,18 @@ class SimulatorServer:
         if not data:
             self._drop(client, "disconnected")
             return
-        self._pending.extend(client.lines.feed(data))
+        lines = client.lines.feed(data)
         if client.lines.overflowed:
             log.error("client %s sent a line longer than %d bytes (lines must end with \\r\\n); "
                       "discarding it up to the next \\r\\n", client.peer, MAX_LINE)
+        if lines:
+            self._pending.extend(lines)
+            self._keep_ticking()
+
+    def _keep_ticking(self) -> None:
+        """Arm the tick timer (aligned to the simulation's period, read at every tick: a START may change it)."""
+        if self._tick_timer is None or not self._tick_timer.active:
+            self._tick_timer = self._reactor.call_every(lambda: self.simulation.period, self._tick)
 
     def _tick(self) -> None:
         lines, self._pending = self._pending, []
@@ -164,6 +151,8 @@ class SimulatorServer:
         out.extend(self.simulation.tick())
         if out:
             self._broadcast(encode_lines(out))
+        if not self.simulation.started and not self._pending and self._tick_timer is not None:
+            self._tick_timer.cancel()  # nothing to simulate: sleep until a line arrives
 
     def _broadcast(self, payload: bytes) -> None:
         for client in list(self._clients.values()):
@@ -182,8 +171,10 @@ class SimulatorServer:
             self._drop(client, f"write failed: {exc}")
             return
         del client.outbuf[:sent]
-        events = selectors.EVENT_READ | (selectors.EVENT_WRITE if client.outbuf else 0)
-        self._selector.modify(client.sock, events, client)
+        if client.outbuf:
+            self._reactor.add_writer(client.sock, lambda: self._flush(client))
+        else:
+            self._reactor.remove_writer(client.sock)
 
     def _drop(self, client: _Client, why: str) -> None:
         if self._clients.pop(client.sock, None) is None:
@@ -191,10 +182,8 @@ class SimulatorServer:
         if client.lines.partial:
             log.info("client %s left a partial line of %d bytes; discarded", client.peer, client.lines.partial)
         log.info("client %s %s (%d connected)", client.peer, why, len(self._clients))
-        try:
-            self._selector.unregister(client.sock)
-        except (KeyError, ValueError):
-            pass
+        self._reactor.remove_reader(client.sock)
+        self._reactor.remove_writer(client.sock)
         client.sock.close()
 
     def _close_all(self) -> None:
@@ -203,6 +192,5 @@ class SimulatorServer:
         self._closed = True
         for client in list(self._clients.values()):
             self._drop(client, "closed by server shutdown")
-        self._selector.close()
-        for sock in (self._listener, self._wake_r, self._wake_w):
-            sock.close()
+        self._reactor.close()
+        self._listener.close()

@@ -39,7 +39,12 @@ def drift_problems(runtime: Iterable[InterfaceEntry], interfaces: Iterable[Appli
                 key = _key(entry.direction, entry.group, entry.scheme, entry.type)
                 static.setdefault(entry.thread.rsplit(".", 1)[-1], set()).add(key)
     seen: dict[str, set[tuple[str, str, str, str]]] = {}
+    # (group, type) a thread subscribed by interthread: a thread may take a group from a publisher in its own
+    # process by interthread instead of interprocess (the embedded FrontSeatTranslation and the interface)
+    local: dict[str, set[tuple[str, str]]] = {}
     for record in runtime:
+        if record.layer == "interthread" and record.direction == "subscribe":
+            local.setdefault(record.thread, set()).add((record.group, _cxx(record.type)))
         if record.layer != "interprocess" or record.group.startswith(INTERNAL_GROUP_PREFIXES):
             continue
         seen.setdefault(record.thread, set()).add(
@@ -50,7 +55,8 @@ def drift_problems(runtime: Iterable[InterfaceEntry], interfaces: Iterable[Appli
         for key in sorted(seen[thread] - static[thread]):
             problems.append(f"{thread}: made at run time but missing from its interface file: {key}")
         for key in sorted(k for k in static[thread] - seen[thread] if k[0] == "subscribes"):
-            problems.append(f"{thread}: in its interface file but never subscribed at run time: {key}")
+            if (key[1], key[3]) not in local.get(thread, set()):
+                problems.append(f"{thread}: in its interface file but never subscribed at run time: {key}")
     return problems
 
 

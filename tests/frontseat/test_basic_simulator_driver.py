@@ -1,4 +1,7 @@
-"""The basic simulator driver against the real simulator (and a scripted TCP peer for lines the sim never sends)."""
+"""The basic simulator driver against the real simulator (and a scripted TCP peer for lines the sim never sends).
+
+The driver does its I/O on a reactor, as in the interface; here the test's thread is the host: ``tick_until`` runs
+the reactor (lines arrive) and ``do_work`` (the tick) in turn."""
 
 from __future__ import annotations
 
@@ -10,6 +13,7 @@ import pytest
 
 from frontseat.basic_simulator_driver import BasicSimulatorDriver, frontseat_driver_load
 from frontseat.errors import DriverConfigError
+from frontseat.line_client import LineConnection
 from frontseat.protobuf import basic_simulator_config_pb2 as sim_pb
 from frontseat.protobuf import basic_simulator_tuning_pb2 as tuning_pb
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
@@ -17,6 +21,7 @@ from frontseat.protobuf import frontseat_pb2 as fs
 from frontseat.simulator.server import SimulatorServer
 from util.geodesy import UTMGeodesy
 from util.process import wait_until
+from util.reactor import Reactor
 
 ORIGIN = (41.592344, -70.711260)
 
@@ -56,12 +61,24 @@ class Recorder:
         driver.signal_command_response.connect(self.responses.append)
 
 
+@pytest.fixture()
+def reactor():
+    host = Reactor("test-host")
+    yield host
+    host.close()
+
+
 def tick_until(driver: BasicSimulatorDriver, condition, timeout: float = 20.0, what: str = ""):
     def step():
+        driver.reactor.run_once(0.01)
         driver.do_work()
         return condition()
 
-    return wait_until(step, timeout=timeout, interval=0.01, what=what)
+    return wait_until(step, timeout=timeout, interval=0.0, what=what)
+
+
+def run_until(reactor: Reactor, condition, timeout: float = 20.0, what: str = ""):
+    return wait_until(lambda: reactor.run_once(0.01) >= 0 and condition(), timeout=timeout, interval=0.0, what=what)
 
 
 def test_missing_extension_is_a_clear_config_error() -> None:
@@ -69,9 +86,15 @@ def test_missing_extension_is_a_clear_config_error() -> None:
         frontseat_driver_load(config_pb.Config())
 
 
-def test_start_nav_command_and_responses_against_the_real_simulator() -> None:
+def test_a_driver_without_a_host_reactor_is_a_clear_config_error() -> None:
+    with pytest.raises(DriverConfigError, match="hosted_on"):
+        BasicSimulatorDriver(make_cfg(1), clock=AdjustableClock())
+
+
+def test_start_nav_command_and_responses_against_the_real_simulator(reactor: Reactor) -> None:
     clock = AdjustableClock()
-    with SimulatorServer() as server, BasicSimulatorDriver(make_cfg(server.port), clock=clock) as driver:
+    with SimulatorServer() as server, \
+            BasicSimulatorDriver(make_cfg(server.port), clock=clock, reactor=reactor) as driver:
         rec = Recorder(driver)
         assert driver.frontseat_state() == fs.FRONTSEAT_NOT_CONNECTED
         tick_until(driver, lambda: driver.frontseat_state() == fs.FRONTSEAT_ACCEPTING_COMMANDS, what="PAYLOAD")
@@ -117,11 +140,11 @@ def test_start_nav_command_and_responses_against_the_real_simulator() -> None:
         tick_until(driver, lambda: not driver.frontseat_providing_data(), what="data timeout")
 
 
-def test_reconnects_and_restarts_after_the_simulator_comes_back() -> None:
+def test_reconnects_and_restarts_after_the_simulator_comes_back(reactor: Reactor) -> None:
     server = SimulatorServer().start()
     port = server.port
     try:
-        with BasicSimulatorDriver(make_cfg(port), clock=AdjustableClock()) as driver:
+        with BasicSimulatorDriver(make_cfg(port), clock=AdjustableClock(), reactor=reactor) as driver:
             rec = Recorder(driver)
             tick_until(driver, driver.frontseat_providing_data, what="first NAV")
             server.stop()
@@ -172,12 +195,12 @@ class ScriptedPeer:
         self.thread.join(timeout=10)
 
 
-def test_ctrl_states_garbage_and_missing_nav_values() -> None:
+def test_ctrl_states_garbage_and_missing_nav_values(reactor: Reactor) -> None:
     peer = ScriptedPeer(
         [b"CTRL,STATE:AUV\r\n", b"garbage,line\r\nNAV,LAT:41.6,LON:-70.7\r\nWHAT,X:1\r\nCTRL\r\n"]
     )
     try:
-        with BasicSimulatorDriver(make_cfg(peer.port), clock=AdjustableClock()) as driver:
+        with BasicSimulatorDriver(make_cfg(peer.port), clock=AdjustableClock(), reactor=reactor) as driver:
             rec = Recorder(driver)
             tick_until(driver, lambda: driver.frontseat_state() == fs.FRONTSEAT_IN_CONTROL, what="CTRL,STATE:AUV")
             driver.send_raw_to_frontseat(fs.Raw(raw=b"NEXT"))
@@ -193,28 +216,42 @@ def test_ctrl_states_garbage_and_missing_nav_values() -> None:
         peer.close()
 
 
-def test_line_client_write_to_a_peer_that_never_reads_times_out_and_reconnects() -> None:
-    from frontseat.line_client import LineClient
-
+def test_link_refuses_a_line_over_its_bound_and_reconnects_when_the_peer_stops_reading(reactor: Reactor) -> None:
     listener = socket.create_server(("127.0.0.1", 0))  # accepts (kernel backlog) but never reads
+    connects: list[float] = []
     try:
-        with LineClient("127.0.0.1", listener.getsockname()[1], io_timeout=0.5, reconnect_interval=0.05) as link:
-            wait_until(lambda: link.connected, what="connection")
-            first = link.connection_id
-            started = time.monotonic()
-            assert link.write_line("X" * (64 * 1024 * 1024)) is False  # far more than the socket buffers hold
-            assert time.monotonic() - started < 10
-            wait_until(lambda: link.connection_id > first and link.connected, what="a fresh connection")
+        with LineConnection(reactor, "127.0.0.1", listener.getsockname()[1], on_line=lambda _line: None,
+                            on_connect=lambda: connects.append(time.monotonic()), io_timeout=0.5,
+                            reconnect_interval=0.05, max_pending=256 * 1024) as link:
+            run_until(reactor, lambda: link.connected, what="connection")
+            assert link.write_line("X" * (1024 * 1024)) is False  # one line over the bound: refused, link kept
+            assert link.connected and link.pending == 0
+            # the peer never reads: the kernel buffers fill, then the queue; writes stall and the link is renewed
+            written = 0
+            while link.connected and link.write_line("Y" * 1000):
+                written += 1
+                reactor.run_once(0)
+            assert written > 10  # what the kernel and the queue took before the bound
+            run_until(reactor, lambda: len(connects) >= 2 and link.connected, what="a fresh connection")
+            assert link.pending == 0  # the stalled bytes went with the old connection (and were logged)
+            assert link.write_line("Z") is True
+            # a queue that stops draining (without filling up) is also a stall: the io_timeout renews the link
+            while link.pending == 0:
+                link.write_line("W" * 60000)
+                reactor.run_once(0)
+            stalled = time.monotonic()
+            run_until(reactor, lambda: len(connects) >= 3, what="the stall to be noticed")
+            assert time.monotonic() - stalled >= 0.4
     finally:
         listener.close()
 
 
-def test_duration_expiry_leads_command_to_listen_then_not_providing_data() -> None:
+def test_duration_expiry_leads_command_to_listen_then_not_providing_data(reactor: Reactor) -> None:
     """§6.5 step 10 with real parts: CTRL,STATE:IDLE ends COMMAND; silence then trips the data timeout."""
     with SimulatorServer() as server:
         cfg = make_cfg(server.port, warp=10, data_timeout=0.5)
         cfg.Extensions[sim_pb.basic_simulator_config].start.duration = 5  # 5 s simulated = 0.5 s real at warp 10
-        with BasicSimulatorDriver(cfg, clock=AdjustableClock()) as driver:
+        with BasicSimulatorDriver(cfg, clock=AdjustableClock(), reactor=reactor) as driver:
             states: list[int] = []
             driver.signal_state_change.connect(states.append)
             driver.set_helm_state(fs.HELM_DRIVE)

@@ -3,7 +3,17 @@
 Goby -> MOOS: each ``node_status`` becomes the NAV_* variables pHelmIvP and pNodeReporter read.
 MOOS -> Goby: DESIRED_SPEED (with the other buffered DESIRED_*) becomes a ``desired_course``; IVPHELM_STATE
 becomes a ``helm_state`` report. Runs as a gateway plugin (``load``/``unload``) and embedded in
-frontseat-interface, which launches it with a GobyMOOSGatewayConfig whose ``app.geodesy`` is the datum.
+frontseat-interface, which launches it with a GobyMOOSGatewayConfig whose ``app.geodesy`` is the datum and
+``embedded=True``.
+
+Where the data goes (Goby's layering): ``helm_state`` and ``desired_course`` are published interprocess, which also
+hands them by interthread to subscribers of this process (the interface's main thread, when embedded); the broker
+carries them to other processes, as gobyd does.  ``node_status`` comes by interthread from the interface's main
+thread when embedded (Goby's forwarder threads get it from the portal's inner publication), and interprocess in
+moos-gateway.
+
+The thread wakes only for work: MOOS mail and node_status as they arrive, and once per simulated second for
+``GOBY_MOOS_TRANSLATOR_TIME`` (Goby's 10 Hz x warp tick has nothing else left to do here).
 """
 
 from __future__ import annotations
@@ -26,6 +36,7 @@ from translators.frontseat.helm_conversion import (
     helm_state,
 )
 from translators.frontseat.nav_conversion import nav_posts
+from translators.moos_interface import TIME_PUBLISH_PERIOD_S
 from util.geodesy import UTMGeodesy
 
 log = logging.getLogger(__name__)
@@ -41,8 +52,12 @@ def geodesy_from_config(cfg: GobyMOOSGatewayConfig) -> UTMGeodesy | None:
 class FrontSeatTranslation(Translator):
     """Moves navigation to the helm and the helm's setpoints and state to the frontseat interface."""
 
-    def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None) -> None:
+    def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None,
+                 embedded: bool = False) -> None:
+        """``embedded``: in frontseat-interface, whose main thread publishes node_status (taken by interthread, so
+        it never leaves the process to come back); otherwise node_status is taken from the broker."""
         super().__init__(cfg, index, comms_kind=comms_kind)
+        self.embedded = embedded
         self._geodesy = geodesy_from_config(cfg)
         if self._geodesy is None:
             log.warning("no app.geodesy datum configured: NAV_X/NAV_Y will be copied from node_status local_fix")
@@ -51,8 +66,16 @@ class FrontSeatTranslation(Translator):
         self.moos().add_trigger(DESIRED_SPEED, self._on_desired_speed)
         self.moos().add_trigger(IVPHELM_STATE, self._on_helm_state)
         interprocess = self.goby().interprocess()
-        interprocess.subscribe(groups.node_status, NodeStatus, self._on_node_status)
+        if embedded:
+            self.goby().interthread().subscribe(groups.node_status, NodeStatus, self._on_node_status)
+        else:
+            interprocess.subscribe(groups.node_status, NodeStatus, self._on_node_status)
         interprocess.subscribe(groups.datum_update, DatumUpdate, self._on_datum_update)
+
+    def effective_loop_frequency_hz(self) -> float:
+        """Once per simulated second: the tick's only work is ``GOBY_MOOS_TRANSLATOR_TIME`` (Goby posts it once per
+        warped second from its 10 Hz loop); mail and node_status are handled as they arrive, not by the tick."""
+        return self.context.clock.effective_warp / TIME_PUBLISH_PERIOD_S
 
     def _on_node_status(self, status: NodeStatus) -> None:
         """Post NAV_* for one NodeStatus. Runs on the translator's thread."""
@@ -77,8 +100,8 @@ class FrontSeatTranslation(Translator):
         except SetpointError as error:
             log.error("no desired_course published: %s", error)
             return
-        for error in errors:
-            log.error("setpoint left out of desired_course: %s", error)
+        for problem in errors:
+            log.error("setpoint left out of desired_course: %s", problem)
         self.goby().interprocess().publish(groups.desired_course, course)
         log.debug("posting to Goby: desired_course %s", course)
 
