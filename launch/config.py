@@ -127,6 +127,7 @@ class EnvSettings:
     """
 
     ENV: ClassVar[Mapping[str, str]]
+    __dataclass_fields__: ClassVar[dict[str, dataclasses.Field[Any]]]  # subclasses are dataclasses
 
     def to_env(self) -> dict[str, str]:
         """The variables that reproduce these settings in a launch line."""
@@ -138,7 +139,7 @@ class EnvSettings:
         return settings_from_env(cls, cls.ENV, environ)
 
     def replace(self: S, **changes: object) -> S:
-        return dataclasses.replace(self, **changes)  # type: ignore[type-var, arg-type]
+        return dataclasses.replace(self, **changes)
 
 
 def check_warp_and_origin(warp: int, lat_origin: float, lon_origin: float) -> None:

@@ -1,7 +1,9 @@
-"""Regenerate (or check) the committed ``*_pb2.py`` files from the ``.proto`` files in the repository.
+"""Regenerate (or check) the committed ``*_pb2.py`` and ``*_pb2.pyi`` files from the repository's ``.proto`` files.
 
 Run ``python -m tools.generate_protos`` after editing a ``.proto``; ``--check`` exits 1 when the committed
-output is stale (the test suite runs it).
+output is stale (the test suite runs it).  The ``.pyi`` stubs come from mypy-protobuf (pinned in pyproject.toml,
+since its output is committed): unlike protoc's own ``--pyi_out`` they type enums, extensions and descriptors
+in a way mypy accepts.
 
 Why a script and not plain ``protoc``: our ``.proto`` files live inside our Python packages and import each
 other by repository-relative path (``import "frontseat/protobuf/frontseat_data.proto";``), which makes the
@@ -15,7 +17,9 @@ from __future__ import annotations
 import argparse
 import importlib.resources
 import re
+import shutil
 import sys
+import sysconfig
 import tempfile
 from pathlib import Path
 
@@ -55,6 +59,15 @@ def _rewrite_imports(text: str) -> str:
     return text
 
 
+def _mypy_plugin() -> str:
+    """The ``protoc-gen-mypy`` executable installed beside this interpreter (or on ``PATH``)."""
+    beside = Path(sysconfig.get_path("scripts")) / "protoc-gen-mypy"
+    found = str(beside) if beside.is_file() else shutil.which("protoc-gen-mypy")
+    if found is None:
+        raise SystemExit("mypy-protobuf is needed to generate the .pyi stubs: pip install -e '.[test]'")
+    return found
+
+
 def run_protoc(files: list[Path], out_dir: Path) -> None:
     """Compile ``files`` into ``out_dir`` with the protoc bundled in grpcio-tools."""
     try:
@@ -68,7 +81,8 @@ def run_protoc(files: list[Path], out_dir: Path) -> None:
         f"-I{REPO_ROOT}",
         f"-I{well_known}",
         f"--python_out={out_dir}",
-        f"--pyi_out={out_dir}",
+        f"--plugin=protoc-gen-mypy={_mypy_plugin()}",
+        f"--mypy_out=quiet:{out_dir}",
         *(str(_virtual_path(f)) for f in files),
     ]
     if protoc.main(args) != 0:

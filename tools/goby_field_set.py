@@ -21,6 +21,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import NotRequired, TypedDict
 
 from google.protobuf import descriptor_pb2
 
@@ -38,6 +39,34 @@ EXCLUDED = ("src/acomms/protobuf/network_header.proto",)
 _IMPORT = re.compile(r'^\s*import\s+(?:public\s+|weak\s+)?"([^"]+)"\s*;', re.M)
 _TYPES = {v: k[len("TYPE_"):].lower() for k, v in descriptor_pb2.FieldDescriptorProto.Type.items()}
 _LABELS = {v: k[len("LABEL_"):].lower() for k, v in descriptor_pb2.FieldDescriptorProto.Label.items()}
+
+
+class FieldEntry(TypedDict):
+    """A field or an extension (extensions have ``extendee`` and a full ``name``)."""
+
+    name: str
+    number: int
+    type: str
+    label: str
+    type_name: NotRequired[str]
+    default: NotRequired[str]
+    extendee: NotRequired[str]
+
+
+class MessageEntry(TypedDict):
+    file: str
+    fields: list[FieldEntry]
+    extension_ranges: list[list[int]]
+
+
+class FieldSet(TypedDict):
+    """The recorded JSON document."""
+
+    source: str
+    generated_by: str
+    messages: dict[str, MessageEntry]
+    enums: dict[str, dict[str, int]]
+    extensions: list[FieldEntry]
 
 
 def _git_show(git_dir: Path, rev: str, path: str) -> str | None:
@@ -82,8 +111,8 @@ def compile_set(src: Path, roots: list[str]) -> descriptor_pb2.FileDescriptorSet
     return descriptor_pb2.FileDescriptorSet.FromString(out.read_bytes())
 
 
-def _field(f: descriptor_pb2.FieldDescriptorProto, scope: str) -> dict[str, object]:
-    entry: dict[str, object] = {"name": f.name, "number": f.number, "type": _TYPES[f.type], "label": _LABELS[f.label]}
+def _field(f: descriptor_pb2.FieldDescriptorProto, scope: str) -> FieldEntry:
+    entry: FieldEntry = {"name": f.name, "number": f.number, "type": _TYPES[f.type], "label": _LABELS[f.label]}
     if f.type_name:
         entry["type_name"] = f.type_name.lstrip(".")
     if f.HasField("default_value"):
@@ -94,11 +123,11 @@ def _field(f: descriptor_pb2.FieldDescriptorProto, scope: str) -> dict[str, obje
     return entry
 
 
-def field_set(files: descriptor_pb2.FileDescriptorSet, rev: str) -> dict[str, object]:
+def field_set(files: descriptor_pb2.FileDescriptorSet, rev: str) -> FieldSet:
     """Goby's messages, enums and extensions as plain data (sorted, so the file diffs well)."""
-    messages: dict[str, object] = {}
-    enums: dict[str, object] = {}
-    extensions: list[dict[str, object]] = []
+    messages: dict[str, MessageEntry] = {}
+    enums: dict[str, dict[str, int]] = {}
+    extensions: list[FieldEntry] = []
 
     def walk(msg: descriptor_pb2.DescriptorProto, scope: str, path: str) -> None:
         full = f"{scope}.{msg.name}" if scope else msg.name
@@ -123,28 +152,26 @@ def field_set(files: descriptor_pb2.FileDescriptorSet, rev: str) -> dict[str, ob
         "generated_by": "python -m tools.goby_field_set",
         "messages": dict(sorted(messages.items())),
         "enums": dict(sorted(enums.items())),
-        "extensions": sorted(extensions, key=lambda e: (str(e["extendee"]), int(e["number"]))),  # type: ignore[call-overload]
+        "extensions": sorted(extensions, key=lambda e: (e["extendee"], e["number"])),
     }
 
 
-def dump(data: dict[str, object]) -> str:
+def dump(data: FieldSet) -> str:
     """JSON with one line per field, enum and extension: readable, and diffs line by line."""
     one = json.dumps
     out = ["{", f' "source": {one(data["source"])},', f' "generated_by": {one(data["generated_by"])},', ' "messages": {']
     messages = data["messages"]
-    assert isinstance(messages, dict)
     for i, (name, msg) in enumerate(messages.items()):
         fields = ",\n".join(f"   {one(f)}" for f in msg["fields"])
         head = f'  {one(name)}: {{"file": {one(msg["file"])}, "extension_ranges": {one(msg["extension_ranges"])}, '
         out.append(head + (f'"fields": [\n{fields}\n  ]}}' if fields else '"fields": []}') + ("," if i < len(messages) - 1 else ""))
     enums = data["enums"]
-    assert isinstance(enums, dict)
     out.append(" },")
     out.append(' "enums": {')
     out.append(",\n".join(f"  {one(name)}: {one(values)}" for name, values in enums.items()))
     out.append(" },")
     out.append(' "extensions": [')
-    out.append(",\n".join(f"  {one(e)}" for e in data["extensions"]))  # type: ignore[attr-defined]
+    out.append(",\n".join(f"  {one(e)}" for e in data["extensions"]))
     out.append(" ]")
     out.append("}")
     return "\n".join(out) + "\n"
@@ -164,7 +191,7 @@ def main(argv: list[str] | None = None) -> int:
     text = dump(data)
     assert json.loads(text) == data
     args.output.write_text(text)
-    print(f"{args.output}: {len(data['messages'])} messages, {len(data['enums'])} enums, "  # type: ignore[arg-type]
+    print(f"{args.output}: {len(data['messages'])} messages, {len(data['enums'])} enums, "
           f"{len(data['extensions'])} extensions from GobySoft/goby3 {args.rev}")
     return 0
 

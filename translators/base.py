@@ -16,8 +16,8 @@ import logging
 import threading
 from collections.abc import Callable
 
-import gateway.moos as moos
 from gateway.goby.portal import MultiThreadApplication, SimpleThread
+from gateway.moos import MoosClock, choose_client
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
 from translators.moos_interface import TIME_VAR, MOOSInterface
 
@@ -52,8 +52,8 @@ class Translator(SimpleThread):
         # Goby's SetMOOSTimeWarp is process-global; our client gets a clock of its own instead, so translators
         # of different gateways (or tests) in one process neither share a warp nor overwrite each other's skew.
         # (The real pymoos has only the process-wide clock: choose_client applies this warp to it.)
-        self._moos_clock = moos.MoosClock(float(sim.warp_factor) if sim.use_sim_time else 1.0)
-        client = moos.choose_client(comms_kind, clock=self._moos_clock)
+        self._moos_clock = MoosClock(float(sim.warp_factor) if sim.use_sim_time else 1.0)
+        client = choose_client(comms_kind, clock=self._moos_clock)
         self._moos = MOOSInterface(
             client.comms,
             self.call_soon,
@@ -73,7 +73,7 @@ class Translator(SimpleThread):
         """The MOOS side: ``add_trigger``, ``add_wildcard_trigger``, ``add_buffer``, ``buffer()``, ``comms()``."""
         return self._moos
 
-    def moos_clock(self) -> moos.MoosClock:
+    def moos_clock(self) -> MoosClock:
         """This translator's MOOS clock (the configured warp, and the skew its client learns); use
         ``moos().moos_time()`` rather than the process-wide ``gateway.moos.time()`` in translator code."""
         return self._moos_clock

@@ -9,13 +9,16 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Callable
+from typing import TypeVar
+
+N = TypeVar("N", int, float)
 
 
-def bounded_number(kind: type = float, low: float = -math.inf, high: float = math.inf,
-                   low_inclusive: bool = True) -> Callable[[str], float]:
-    """A validator: ``kind(text)`` that must be finite and within [low, high] (or (low, high])."""
+def bounded_number(kind: type[N], low: float = -math.inf, high: float = math.inf,
+                   low_inclusive: bool = True) -> Callable[[str], N]:
+    """A validator: ``kind(text)`` (int or float), finite and within [low, high] (or (low, high])."""
 
-    def parse(text: str) -> float:
+    def parse(text: str) -> N:
         try:
             value = kind(text)
         except ValueError:

@@ -182,7 +182,10 @@ class ChildProcess:
                 line = next((line for line in text.splitlines() if test(line)), None)
                 return None if line is None else re.fullmatch(".*", line)
         else:
-            find = (re.compile(pattern, re.MULTILINE) if isinstance(pattern, str) else pattern).search
+            regex = re.compile(pattern, re.MULTILINE) if isinstance(pattern, str) else pattern
+
+            def find(text: str) -> re.Match[str] | None:
+                return regex.search(text)
         deadline = time.monotonic() + timeout
         while True:
             ended = not self.running  # read once more after the child ended: it may have printed just before

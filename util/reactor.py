@@ -184,6 +184,14 @@ class Reactor:
         self._sequence = itertools.count()
         self._running = False
         self._closed = False
+        self._owner = threading.get_ident()  # the thread that runs it (last to call run_once), else its creator
+
+    def in_owner_thread(self) -> bool:
+        """True on the thread that runs this reactor (or, before it first ran, the one that created it).
+
+        Lets a component on a reactor it was given refuse to block the thread that would have to wake it.
+        """
+        return threading.get_ident() == self._owner
 
     # -------------------------------------------------------------------------------- sources
     def add_reader(self, source: Source, handler: Handler) -> None:
@@ -292,6 +300,7 @@ class Reactor:
 
         Due timers run before and after the poll, so a periodic tick is never starved by steady traffic.
         """
+        self._owner = threading.get_ident()
         events = self.mailbox.drain() if self.mailbox.pending() else 0
         events += self._run_due_timers(time.monotonic())
         if events:

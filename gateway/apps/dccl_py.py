@@ -29,7 +29,6 @@ from google.protobuf import (
     descriptor_pb2,
     descriptor_pool,
     message_factory,
-    symbol_database,
     text_encoding,
     text_format,
 )
@@ -37,6 +36,7 @@ from google.protobuf.descriptor import Descriptor
 from google.protobuf.message import Message
 
 from gateway.goby.dccl import Codec, DcclError
+from util.descriptors import descriptor_of
 from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
@@ -120,7 +120,7 @@ class Types:
                     self.from_files.extend(f"{proto.package}.{m.name}".lstrip(".") for m in proto.message_type)
 
     def find(self, name: str) -> type[Message]:
-        for pool in (self.pool, symbol_database.Default().pool):
+        for pool in (self.pool, descriptor_pool.Default()):
             try:
                 return message_factory.GetMessageClass(pool.FindMessageTypeByName(name))
             except KeyError:
@@ -249,7 +249,7 @@ def main(argv: list[str] | None = None) -> int:
             elif args.action == "source":
                 print(f"# {name}\n{codec.source(message_type)}")
             else:
-                print(display_proto(message_type.DESCRIPTOR))
+                print(display_proto(descriptor_of(message_type)))
         return EXIT_FAILED if failed else EXIT_OK
     except ToolError as exc:
         print(f"{PROG}: {exc}", file=sys.stderr)

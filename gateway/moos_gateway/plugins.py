@@ -69,9 +69,10 @@ def resolve_plugins(entries: list[str]) -> list[Plugin]:
     plugins: list[Plugin] = []
     for entry in entries:
         plugin = resolve_plugin(entry)
+        module = plugin.module
         for earlier in plugins:
-            if earlier.module is plugin.module:
-                cause = f"module {plugin.module.__name__} is already loaded as {earlier.entry}"
+            if module is not None and earlier.module is module:
+                cause = f"module {module.__name__} is already loaded as {earlier.entry}"
                 raise ExtensionError(f"plugin {entry}: {cause} (listed twice in {ENV_VAR})", spec=entry, cause=cause)
         plugins.append(plugin)
     return plugins

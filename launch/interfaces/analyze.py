@@ -58,7 +58,7 @@ class _Where:
 
 def cxx_type_name(message_type: type) -> str:
     """Goby's interface files name types as C++ does: ``goby::middleware::frontseat::protobuf::NodeStatus``."""
-    if isinstance(message_type, type) and issubclass(message_type, Message):
+    if issubclass(message_type, Message):
         return message_type.DESCRIPTOR.full_name.replace(".", "::")
     if message_type is str:
         return "std::string"
@@ -195,7 +195,7 @@ class _ModuleAnalyzer(ast.NodeVisitor):
             )
         if isinstance(expr, ast.Attribute):
             owner = self._message_type(expr.value, node)
-            if isinstance(owner, type) and issubclass(owner, Message):
+            if issubclass(owner, Message):
                 field = owner.DESCRIPTOR.fields_by_name.get(expr.attr)
                 if field is not None and field.message_type is not None:
                     return self._class_for(field.message_type.full_name, node)

@@ -214,8 +214,9 @@ def to_dot(graph: Graph, options: VizOptions | None = None) -> str:
     for node, _labels in graph.nodes.values():
         by_platform.setdefault(node.platform, {}).setdefault(node.module, {}).setdefault(node.application, set()).add(node.id)
 
-    def edges_where(pred) -> list[Edge]:
-        return [e for e in graph.edges if pred(e)]
+    def edges_on(layer: str, publishers: set[str] | None = None) -> list[Edge]:
+        """The edges of ``layer``, published by one of ``publishers`` if given."""
+        return [e for e in graph.edges if e.layer == layer and (publishers is None or e.publisher.id in publishers)]
 
     def disconnected(node_ids: set[str], layer: str, indent: str) -> list[str]:
         lines = []
@@ -253,7 +254,7 @@ def to_dot(graph: Graph, options: VizOptions | None = None) -> str:
                 platform_ids |= ids
                 out += [f"\t\tsubgraph cluster_{next(cluster)} {{", f"\t\t\tlabel=<<b>{html.escape(app)}</b>>",
                         f'\t\t\tfontcolor="{PROCESS_COLOR}"', "\t\t\tpenwidth=2", f'\t\t\tpencolor="{PROCESS_COLOR}20"']
-                for edge in edges_where(lambda e, ids=ids: e.layer == "interthread" and e.publisher.id in ids):
+                for edge in edges_on("interthread", ids):
                     out.append("\t\t\t" + _edge_line(edge, THREAD_COLOR))
                 out += disconnected(ids, "interthread", "\t\t\t")
                 out += [f'\t\t\t{node_id}[penwidth=2,color="{THREAD_COLOR}20"]' for node_id in sorted(ids)]
@@ -261,12 +262,12 @@ def to_dot(graph: Graph, options: VizOptions | None = None) -> str:
             if real_module:
                 out.append("\t}")
         for layer in ("intermodule", "interprocess"):
-            for edge in edges_where(lambda e, layer=layer, ids=platform_ids: e.layer == layer and e.publisher.id in ids):
+            for edge in edges_on(layer, platform_ids):
                 out.append("\t\t" + _edge_line(edge, LAYER_COLOR[layer]))
             out += disconnected(platform_ids, layer, "\t\t")
         out.append("\t}")
     all_ids = set(graph.nodes)
-    for edge in edges_where(lambda e: e.layer == "intervehicle"):
+    for edge in edges_on("intervehicle"):
         out.append("\t" + _edge_line(edge, VEHICLE_COLOR))
     out += disconnected(all_ids, "intervehicle", "\t")
     for node_id in sorted(graph.nodes):

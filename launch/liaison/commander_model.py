@@ -20,12 +20,13 @@ from gateway.goby.portal.group import Group
 from gateway.goby.protobuf.layer_pb2 import LAYER_INTERVEHICLE, Layer
 from launch.liaison.form_schema import message_schema
 from launch.liaison.protobuf.liaison_web_pb2 import InterProcessAck
+from util.descriptors import descriptor_of
 
 #: Sent, then one of the final states.
 SENDING, SENT, ACKNOWLEDGED, REFUSED, EXPIRED, FAILED = "sending", "sent", "acknowledged", "refused", "expired", "failed"
 
 
-def layer_text(layer: int) -> str:
+def layer_text(layer: Layer.ValueType) -> str:
     """Goby's ``to_string(Layer)``: the enum name without ``LAYER_``, lower case."""
     return Layer.Name(layer).removeprefix("LAYER_").lower()
 
@@ -38,7 +39,7 @@ class Target:
     group: str
     numeric: int
     numeric_field: str
-    layer: int
+    layer: Layer.ValueType
 
     @property
     def label(self) -> str:
@@ -66,7 +67,7 @@ class CommandType:
     ack: InterProcessAck | None = None
 
     def view(self) -> dict[str, Any]:
-        return {"name": self.name, "schema": message_schema(self.cls.DESCRIPTOR),
+        return {"name": self.name, "schema": message_schema(descriptor_of(self.cls)),
                 "targets": [{"index": t.index, "label": t.label, "layer": layer_text(t.layer)} for t in self.targets]}
 
 

@@ -16,6 +16,7 @@ from google.protobuf.descriptor import Descriptor, FieldDescriptor
 
 from gateway.goby.dccl import numeric_bounds
 from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as dccl_options
+from util.descriptors import enum_type_of, message_type_of
 
 MAX_DEPTH = 8  # nesting shown for (possibly recursive) sub-messages
 DEFAULT_MAX_REPEAT = 100  # elements offered for a repeated field without (dccl.field).max_repeat
@@ -97,7 +98,7 @@ def _default(field: FieldDescriptor) -> Any:
     if field.is_repeated or field.type == FieldDescriptor.TYPE_MESSAGE or not field.has_default_value:
         return None
     if field.type == FieldDescriptor.TYPE_ENUM:
-        return field.enum_type.values_by_number[field.default_value].name
+        return enum_type_of(field).values_by_number[field.default_value].name
     if field.type == FieldDescriptor.TYPE_BYTES:
         return field.default_value.hex()
     if field_kind(field) in ("int64", "uint64"):
@@ -125,7 +126,7 @@ def _field_schema(field: FieldDescriptor, depth: int) -> dict[str, Any]:
             out["step"] = step
         out["dccl_bounds"] = from_dccl
     if kind == "enum":
-        out["enum"] = [value.name for value in field.enum_type.values]
+        out["enum"] = [value.name for value in enum_type_of(field).values]
     if options.HasField("static_value") and options.codec == "dccl.static":
         out["static_value"] = options.static_value
     if options.HasField("max_length"):
@@ -136,8 +137,9 @@ def _field_schema(field: FieldDescriptor, depth: int) -> dict[str, Any]:
         out["max_repeat"] = options.max_repeat if options.HasField("max_repeat") else DEFAULT_MAX_REPEAT
         out["min_repeat"] = options.min_repeat
     if kind == "message":
-        out["message"] = (message_schema(field.message_type, depth + 1) if depth < MAX_DEPTH
-                          else {"name": field.message_type.full_name, "fields": [], "truncated": True})
+        sub = message_type_of(field)
+        out["message"] = (message_schema(sub, depth + 1) if depth < MAX_DEPTH
+                          else {"name": sub.full_name, "fields": [], "truncated": True})
     return out
 
 

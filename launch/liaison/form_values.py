@@ -28,6 +28,7 @@ from launch.liaison.form_schema import (
     numeric_limits,
 )
 from translators.usv.validation import DcclBoundsError, check_dccl_bounds
+from util.descriptors import descriptor_of, enum_type_of
 
 MAX_TEXT = 10_000  # characters accepted for one string or bytes value without (dccl.field).max_length
 
@@ -83,10 +84,11 @@ def _scalar(field: FieldDescriptor, value: Any, path: str) -> Any:
         else:
             raise CommandRefused(f"{path}: expected true or false, got {value!r}", path)
     elif kind == "enum":
-        names = [v.name for v in field.enum_type.values]
+        enum_type = enum_type_of(field)
+        names = [v.name for v in enum_type.values]
         if not isinstance(value, str) or value not in names:
             raise CommandRefused(f"{path}: {value!r} is not one of {', '.join(names)}", path)
-        result = field.enum_type.values_by_name[value].number
+        result = enum_type.values_by_name[value].number
     elif kind == "string":
         if not isinstance(value, str):
             raise CommandRefused(f"{path}: expected text, got {type(value).__name__}", path)
@@ -127,11 +129,12 @@ def fill_message(msg: Message, values: Any, now: Callable[[], float], path: str 
     where = path or msg.DESCRIPTOR.name
     if not isinstance(values, dict):
         raise CommandRefused(f"{where}: expected an object of field values, got {type(values).__name__}", path)
-    fields = msg.DESCRIPTOR.fields_by_name
+    descriptor = descriptor_of(msg)
+    fields = descriptor.fields_by_name
     unknown = sorted(set(values) - set(fields))
     if unknown:
         raise CommandRefused(f"{where}: no field named {', '.join(map(repr, unknown))}", f"{path}{unknown[0]}")
-    for field in msg.DESCRIPTOR.fields:
+    for field in descriptor.fields:
         fpath = f"{path}{field.name}"
         if is_auto_time(field):
             seconds = now()

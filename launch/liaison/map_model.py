@@ -21,7 +21,7 @@ from collections import Counter, deque
 from dataclasses import dataclass, field
 from typing import Any
 
-from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
+from frontseat.protobuf.frontseat_data_pb2 import NodeStatus, VehicleType
 from launch.liaison.form_schema import dccl_bounds
 from launch.usv.geometry import radial_polygon
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
@@ -164,8 +164,7 @@ class MapModel:
                              MAX_VEHICLES, name, group)
                 return None
             vehicle = self._vehicles[name] = _Vehicle(name, deque(maxlen=self.trail_points))
-        vehicle.type = NodeStatus.DESCRIPTOR.fields_by_name["type"].enum_type.values_by_number[status.type].name \
-            if status.HasField("type") else ""
+        vehicle.type = VehicleType.Name(status.type) if status.HasField("type") else ""
         vehicle.x, vehicle.y = x, y
         vehicle.heading = status.pose.heading % 360.0
         vehicle.speed = status.speed.over_ground

@@ -20,7 +20,7 @@ from launch.liaison.commander_model import CommandType, Target
 from launch.liaison.errors import LiaisonConfigError
 from launch.liaison.message_types import find_message_type, import_project_protos, load_message_modules
 from launch.liaison.name_filter import compile_filter
-from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
+from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig, ProtobufCommanderConfig
 from launch.liaison.protobuf.liaison_web_pb2 import InterProcessAck, WebConfig, web
 
 Point = tuple[float, float]
@@ -58,7 +58,7 @@ def web_config(cfg: LiaisonConfig) -> WebConfig:
     return cfg.Extensions[web]
 
 
-def _targets(load: LiaisonConfig, cls: type[Message], where: str) -> tuple[Target, ...]:
+def _targets(load: ProtobufCommanderConfig.LoadProtobuf, cls: type[Message], where: str) -> tuple[Target, ...]:
     targets = []
     for index, entry in enumerate(load.publish_to):
         numeric_field = entry.group_numeric_field_name if entry.HasField("group_numeric_field_name") else ""

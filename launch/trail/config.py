@@ -185,7 +185,9 @@ def _liaison(settings: TrailSettings, vehicle: Vehicle) -> str:
     return render(TEMPLATES / "liaison.pb.cfg.in", values)
 
 
-def _vehicle_only(kinds: tuple[str, ...], app: str, generate: Callable[[TrailSettings, Vehicle], str]):
+def _vehicle_only(
+    kinds: tuple[str, ...], app: str, generate: Callable[[TrailSettings, Vehicle], str]
+) -> Callable[[TrailSettings, Vehicle], str]:
     def checked(settings: TrailSettings, vehicle: Vehicle) -> str:
         if vehicle.kind not in kinds:
             raise MissionConfigError(f"App: {app} is not defined for platform {vehicle.kind}")

@@ -14,6 +14,7 @@ bounds first, as usv-command does) and ``T:recover``; T in sim seconds after eve
 
 from __future__ import annotations
 
+import functools
 import logging
 import queue
 from collections.abc import Callable
@@ -137,7 +138,7 @@ class Operator:
         while self.t0 is not None and self.plan and self.plan[0].at <= self.clock.now() - self.t0:
             planned = self.plan.pop(0)
             if planned.usv is not None:
-                self.topside.submit(lambda thread, p=planned: self._send_usv_command(thread, p))
+                self.topside.submit(functools.partial(self._send_usv_command, planned=planned))
             elif self.usv is not None:
                 self.usv.submit(self._send_recover)
 

@@ -78,8 +78,8 @@ def write_trail_png(path: Path, records: dict[str, MissionRecord], commands: lis
 
     rel.plot(0, 0, marker="^", markersize=12, color="black", linestyle="none", label="USV (heading up)")
     for trail in trails:
-        name = next((n for n in auvs if f"AUV_{n[3:]}" == trail.name), None)
-        c = colour.get(name or "", "tab:gray")
+        auv = next((n for n in auvs if f"AUV_{n[3:]}" == trail.name), None)
+        c = colour.get(auv or "", "tab:gray")
         points = [(x, y) for t, x, y in trail.relative if t >= (trail.settled_at or 0) and t <= trail.end]
         if points:
             rel.scatter([p[0] for p in points], [p[1] for p in points], s=4, color=c, alpha=0.5,

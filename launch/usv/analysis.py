@@ -256,9 +256,10 @@ def waypoint_approach(
         t_end, ended_by_command = t0 + window_s, False
     seglists = [e for e in record.events_named("VIEW_SEGLIST", source="moos") if t0 <= e.t <= t_end]
     points = parse_points(seglists[0].value) if seglists else []
-    target = (points or waypoints or [None])[0]
-    if target is None:
+    targets = points or waypoints
+    if not targets:
         return None
+    target = targets[0]
     nav = [s for s in all_nav if t0 <= s.t <= t_end]
     if not nav:
         return None

@@ -23,6 +23,7 @@ import time
 from google.protobuf import text_format
 
 from gateway.goby.portal import SingleThreadApplication, run_application
+from gateway.goby.portal.config import example_config
 from translators.usv import groups
 from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
@@ -126,7 +127,8 @@ def main(argv: list[str] | None = None) -> int:
     """Console script ``usv-command``."""
     argv = sys.argv[1:] if argv is None else list(argv)
     if {"-e", "--example_config"} & set(argv):  # the Goby option works without a command
-        return run_application(lambda cfg: None, CommandTool, ["--example_config"], prog=PROG)
+        print(example_config(CommandTool))
+        return 0
     parser = build_parser()
     args, goby_argv = parser.parse_known_args(argv)
     notices: list[str] = []

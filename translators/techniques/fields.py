@@ -24,6 +24,7 @@ from translators.techniques.numbers import (
     stream_double,
     stream_float,
 )
+from util.descriptors import enum_type_of
 
 CPP = FieldDescriptor
 
@@ -47,7 +48,7 @@ def value_to_moos(field: FieldDescriptor, value: Any, use_short_enum: bool = Fal
     if cpp == CPP.CPPTYPE_DOUBLE:
         return stream_double(value)
     if cpp == CPP.CPPTYPE_ENUM:
-        enum_value = field.enum_type.values_by_number.get(value)
+        enum_value = enum_type_of(field).values_by_number.get(value)
         name = enum_value.name if enum_value is not None else str(value)
         return strip_name_from_enum(name, field.name) if use_short_enum else name
     return str(value)
@@ -69,7 +70,7 @@ def element_zero(field: FieldDescriptor) -> Any:
     """The default of one element of a repeated scalar field (repeated fields carry no declared default)."""
     cpp = field.cpp_type
     if cpp == CPP.CPPTYPE_ENUM:
-        return field.enum_type.values[0].number
+        return enum_type_of(field).values[0].number
     if cpp == CPP.CPPTYPE_BOOL:
         return False
     if cpp == CPP.CPPTYPE_STRING:
@@ -97,7 +98,7 @@ def value_from_moos(field: FieldDescriptor, text: str, use_short_enum: bool = Fa
         return _unhex(text, field)
     if cpp == CPP.CPPTYPE_ENUM:
         name = field.name.upper() + "_" + text if use_short_enum else text
-        values = field.enum_type.values_by_name
+        values = enum_type_of(field).values_by_name
         for candidate in (name, name.upper(), name.lower()):
             if candidate in values:
                 return values[candidate].number

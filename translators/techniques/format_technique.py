@@ -9,6 +9,7 @@ its first occurrence, and a directive takes the input up to the template charact
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
@@ -22,6 +23,7 @@ from translators.techniques.fields import (
     value_from_moos,
     value_to_moos,
 )
+from util.descriptors import descriptor_of
 
 CPP = FieldDescriptor
 _PATH = re.compile(r"%([0-9.]+:)+[0-9.]+%")
@@ -34,7 +36,7 @@ def format_message(msg: Message, fmt: str, repeated_delimiter: str = ",", use_sh
 
     Raises TechniqueError for a bad path (``%3:1%`` where 3 is no message) or a malformed template.
     """
-    desc = msg.DESCRIPTOR
+    desc = descriptor_of(msg)
     # Goby's quirk: the first declared field is left out of the maximum (1 is the floor).
     highest = max([1] + [f.number for f in desc.fields[1:]])
     virtual: dict[int, str] = {}
@@ -75,7 +77,7 @@ def _field_text(msg: Message, field: FieldDescriptor, index: int | None, delimit
     return value_to_moos(field, value[index], short) if index < len(value) else default_to_moos(field, short)
 
 
-def _render(template: str, argument, original: str) -> str:
+def _render(template: str, argument: Callable[[int], str], original: str) -> str:
     out: list[str] = []
     pos = 0
     for match in _DIRECTIVE.finditer(template):
@@ -103,7 +105,7 @@ def _descend(msg: Message, path: list[str], spec: str, create: bool) -> Message:
     sub = msg
     for step in path:
         number, _, index_text = step.partition(".")
-        field = sub.DESCRIPTOR.fields_by_number.get(int(number)) if number.isdigit() else None
+        field = descriptor_of(sub).fields_by_number.get(int(number)) if number.isdigit() else None
         if field is None or field.cpp_type != CPP.CPPTYPE_MESSAGE:
             raise TechniqueError(
                 f"Invalid ':' syntax given for format: {spec}. All field indices except the last must be embedded messages"
@@ -162,7 +164,7 @@ def parse_format(
 
 
 def _parse_field(extract: str, msg: Message, spec: str, delimiter: str, short: bool) -> None:
-    desc = msg.DESCRIPTOR
+    desc = descriptor_of(msg)
     number, dot, index_text = spec.partition(".")
     if not _is_int(number) or (dot and not _is_int(index_text)):
         raise TechniqueError(f"Bad specifier: {spec}, must be an integer. For message: {desc.full_name}")

@@ -8,10 +8,13 @@ first (so string values come back in lower case), as Goby does.
 
 from __future__ import annotations
 
+from typing import Any
+
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
 from translators.techniques.fields import add_value, set_value, value_from_moos, value_to_moos
+from util.descriptors import descriptor_of, message_type_of
 
 CPP = FieldDescriptor
 
@@ -19,7 +22,7 @@ CPP = FieldDescriptor
 def to_key_values(msg: Message, use_short_enum: bool = False) -> str:
     """``msg`` as comma-separated ``key=value`` pairs (unset singular and empty repeated fields left out)."""
     entries: list[str] = []
-    for field in msg.DESCRIPTOR.fields:
+    for field in descriptor_of(msg).fields:
         repeated = field.is_repeated
         value = getattr(msg, field.name)
         if (repeated and len(value) == 0) or (not repeated and not msg.HasField(field.name)):
@@ -33,10 +36,10 @@ def to_key_values(msg: Message, use_short_enum: bool = False) -> str:
     return ",".join(entries)
 
 
-def _embedded(field: FieldDescriptor, value, repeated: bool, use_short_enum: bool) -> list[str]:
+def _embedded(field: FieldDescriptor, value: Any, repeated: bool, use_short_enum: bool) -> list[str]:
     out: list[str] = []
     elements = list(value) if repeated else [value]
-    for sub in field.message_type.fields:
+    for sub in message_type_of(field).fields:
         shown = ",".join(_sub_value(element, sub, use_short_enum) for element in elements)
         out.append(f"{field.name}_{sub.name}=" + ("{" + shown + "}" if repeated else shown))
     return out
@@ -72,7 +75,7 @@ def value_for_key(text: str, key: str) -> str | None:
 def from_key_values(text: str, msg: Message, use_short_enum: bool = False) -> Message:
     """Merge the ``key=value`` pairs of ``text`` into ``msg`` (fields not named are left alone); returns ``msg``."""
     text = text.lower()
-    for field in msg.DESCRIPTOR.fields:
+    for field in descriptor_of(msg).fields:
         if field.cpp_type == CPP.CPPTYPE_MESSAGE:
             _parse_embedded(text, msg, field, use_short_enum)
             continue
@@ -84,7 +87,7 @@ def from_key_values(text: str, msg: Message, use_short_enum: bool = False) -> Me
 
 def _parse_embedded(text: str, msg: Message, field: FieldDescriptor, use_short_enum: bool) -> None:
     repeated = field.is_repeated
-    for sub in field.message_type.fields:
+    for sub in message_type_of(field).fields:
         found = value_for_key(text, f"{field.name}_{sub.name}")
         if found is None:
             continue

@@ -16,6 +16,7 @@ from google.protobuf.message import Message
 
 from translators.techniques.errors import TechniqueError
 from translators.techniques.numbers import simple_dtoa, simple_ftoa
+from util.descriptors import enum_type_of, message_type_of
 
 CPP = FieldDescriptor
 
@@ -43,8 +44,8 @@ def from_text_format(text: str, msg: Message) -> Message:
 def _print_message(msg: Message, parts: list[str]) -> None:
     for field, value in msg.ListFields():
         name = _field_name(field)
-        if field.cpp_type == CPP.CPPTYPE_MESSAGE and field.message_type.GetOptions().map_entry:
-            entry_type = field.message_type
+        if field.cpp_type == CPP.CPPTYPE_MESSAGE and message_type_of(field).GetOptions().map_entry:
+            entry_type = message_type_of(field)
             for key in sorted(value):
                 entry = message_factory.GetMessageClass(entry_type)(key=key, value=value[key])
                 _print_value(name, field, entry, parts)
@@ -59,7 +60,7 @@ def _field_name(field: FieldDescriptor) -> str:
     if field.is_extension:
         return f"[{field.full_name}]"
     if field.type == CPP.TYPE_GROUP:
-        return field.message_type.name
+        return message_type_of(field).name
     return field.name
 
 
@@ -85,6 +86,6 @@ def scalar_text(field: FieldDescriptor, value: Any) -> str:
         raw = value if isinstance(value, bytes) else value.encode("utf-8")
         return '"' + text_encoding.CEscape(raw, as_utf8=False) + '"'
     if cpp == CPP.CPPTYPE_ENUM:
-        enum_value = field.enum_type.values_by_number.get(value)
+        enum_value = enum_type_of(field).values_by_number.get(value)
         return enum_value.name if enum_value is not None else str(value)
     return str(value)

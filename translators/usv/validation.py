@@ -17,6 +17,7 @@ from google.protobuf.message import Message
 from gateway.goby.dccl import Codec, DcclError
 from gateway.goby.portal.marshalling import is_dccl
 from translators.errors import TranslatorError
+from util.descriptors import descriptor_of, initialization_errors
 
 log = logging.getLogger(__name__)
 
@@ -39,9 +40,9 @@ def check_dccl_bounds(msg: M, notices: list[str] | None = None, codec: Codec | N
     DCCL options is only checked for its required fields.
     """
     if not is_dccl(type(msg)):  # no (dccl.msg) options: DCCL never carries it, only protobuf's rules apply
-        missing = msg.FindInitializationErrors()
+        missing = initialization_errors(msg)
         if missing:
-            raise DcclBoundsError(f"{msg.DESCRIPTOR.full_name} is missing required field(s): {', '.join(missing)}")
+            raise DcclBoundsError(f"{descriptor_of(msg).full_name} is missing required field(s): {', '.join(missing)}")
         copy = type(msg)()
         copy.CopyFrom(msg)
         return copy
@@ -51,6 +52,7 @@ def check_dccl_bounds(msg: M, notices: list[str] | None = None, codec: Codec | N
         delivered = codec.decode(codec.encode(msg, strict=True))
     except DcclError as error:
         raise DcclBoundsError(str(error)) from None
+    assert isinstance(delivered, type(msg))  # the codec decodes into the class it loaded
     bounds = {b.name: b for b in codec.bounds(type(msg))}
     for field, value in msg.ListFields():
         spec = bounds.get(field.name)

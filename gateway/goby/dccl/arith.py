@@ -14,7 +14,7 @@ DBL_EPSILON = 2.220446049250313e-16
 _F32 = struct.Struct("<f")
 
 
-def ceil_log2(value: float) -> int:
+def ceil_log2(value: int | float) -> int:
     """Bits needed for ``value`` distinct values: DCCL's ``ceil_log2`` (``ceil`` first, then integer log2)."""
     v = math.ceil(value) if isinstance(value, float) else value
     if v <= 0:

@@ -102,6 +102,7 @@ def numeric_bounds(field: FieldDescriptor, registry: CodecRegistry | None = None
         return None
     if factory is not NumericCodec:
         return None
-    codec = NumericCodec(FieldContext(descriptor=field, options=options, message=field.containing_type.full_name,
+    message = field.containing_type.full_name if field.containing_type is not None else ""
+    codec = NumericCodec(FieldContext(descriptor=field, options=options, message=message,
                                       path=field.name, codec_version=SUPPORTED_VERSION, required=True, strict=False))
     return codec.lower(), codec.upper(), codec.resolution()

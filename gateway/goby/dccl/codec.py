@@ -30,6 +30,7 @@ from gateway.goby.dccl.errors import (
 )
 from gateway.goby.dccl.info import render_info
 from gateway.goby.dccl.registry import CodecRegistry, default_registry
+from util.descriptors import descriptor_of
 
 MessageType = type[Message] | Descriptor
 
@@ -37,7 +38,7 @@ MessageType = type[Message] | Descriptor
 def _descriptor(message_type: MessageType | Message) -> Descriptor:
     if isinstance(message_type, Descriptor):
         return message_type
-    return message_type.DESCRIPTOR
+    return descriptor_of(message_type)
 
 
 class Codec:
@@ -163,7 +164,7 @@ class Codec:
 
     def decode_all(self, data: bytes, *, now: float | None = None) -> list[Message]:
         """Every message of several packed back to back (a modem frame), each found by its id."""
-        out = []
+        out: list[Message] = []
         start = 0
         while start < len(data):
             try:

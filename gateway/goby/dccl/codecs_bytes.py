@@ -209,8 +209,8 @@ class StaticCodec(InlineCodec):
         super().__init__(field)
         self.value: Any = None
 
-    min_size = 0  # type: ignore[assignment]
-    max_size = 0  # type: ignore[assignment]
+    min_size = 0
+    max_size = 0
 
     def validate(self) -> None:
         options, ftype = self.field.options, self.field.descriptor.type
@@ -241,8 +241,8 @@ class IdFieldCodec(InlineCodec):
     """``dccl.default.id`` on a uint32 field: the id codec's 1 or 2 bytes. An unset field arrives as 0."""
 
     variable = True
-    min_size = ids.ID_MIN_BITS  # type: ignore[assignment]
-    max_size = ids.ID_MAX_BITS  # type: ignore[assignment]
+    min_size = ids.ID_MIN_BITS
+    max_size = ids.ID_MAX_BITS
 
     def describe(self) -> dict[str, Any]:
         return {"min": 0, "max": ids.TWO_BYTE_MAX_ID}

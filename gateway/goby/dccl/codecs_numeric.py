@@ -17,6 +17,7 @@ from google.protobuf.descriptor import FieldDescriptor
 from gateway.goby.dccl import arith
 from gateway.goby.dccl.field_codec import INTEGER_TYPES, FieldContext, InlineCodec, int_width
 from gateway.goby.dccl.source import Sink, Source
+from util.descriptors import enum_type_of
 
 log = logging.getLogger(__name__)
 
@@ -142,6 +143,8 @@ class NumericCodec(InlineCodec):
 
     def validate_numeric_bounds(self) -> None:
         lo, hi, res, require = self.lower(), self.upper(), self.resolution(), self.field.require
+        low: float
+        high: float
         if self.kind == "int":
             low, high = (-(1 << (self.int_bits - 1)), (1 << (self.int_bits - 1)) - 1) if self.signed else (
                 0, (1 << self.int_bits) - 1)
@@ -302,7 +305,7 @@ def _integral_step(codec: NumericCodec) -> bool:
             and res < 2.0 ** 52)
 
 
-def _decoded_int_fits(codec: NumericCodec, qmin: int, step: int = 1) -> bool:
+def _decoded_int_fits(codec: NumericCodec, qmin: float, step: int = 1) -> bool:
     """True when every code decodes without overflowing the field's integer type (no wrapping needed)."""
     codes = (1 << codec.size) - 1
     low, high = (-(1 << (codec.int_bits - 1)), (1 << (codec.int_bits - 1)) - 1) if codec.signed else (
@@ -316,8 +319,7 @@ class EnumCodec(NumericCodec):
     def __init__(self, field: FieldContext) -> None:
         super().__init__(field)
         self.kind, self.int_bits, self.signed = "int", 32, True
-        enum = field.descriptor.enum_type
-        self.numbers = [v.number for v in enum.values]
+        self.numbers = [v.number for v in enum_type_of(field.descriptor).values]
         self.packed = field.options.packed_enum
 
     def lower(self) -> float:
@@ -330,11 +332,11 @@ class EnumCodec(NumericCodec):
         """DCCL validates nothing for enums."""
 
     def describe(self) -> dict[str, Any]:
-        values = self.field.descriptor.enum_type.values
+        values = enum_type_of(self.field.descriptor).values
         return {"enum": [(v.name, v.number) for v in values]}
 
     def bounds_text(self) -> str:
-        return "{" + ", ".join(v.name for v in self.field.descriptor.enum_type.values) + "}"
+        return "{" + ", ".join(v.name for v in enum_type_of(self.field.descriptor).values) + "}"
 
     def _simple(self) -> bool:
         return self.packed and self.resolution() == 1

@@ -31,6 +31,7 @@ from gateway.goby.dccl.field_codec import Bits, InlineCodec
 from gateway.goby.dccl.layout import FieldLayout, LayoutBuilder, check_message_options, walk
 from gateway.goby.dccl.registry import CodecRegistry
 from gateway.goby.dccl.source import BitReader, BitWriter, Sink, Source, shifted
+from util.descriptors import descriptor_of, initialization_errors
 
 
 @dataclass
@@ -73,7 +74,7 @@ class CompiledMessage:
 
 def missing_fields(msg: Message) -> MissingFieldError:
     """The error for a message whose required fields are not all set."""
-    return MissingFieldError(msg.DESCRIPTOR.full_name, msg.FindInitializationErrors())
+    return MissingFieldError(descriptor_of(msg).full_name, initialization_errors(msg))
 
 
 def truncated(name: str, have: int, need: int, what: str = "bytes") -> TruncatedError:

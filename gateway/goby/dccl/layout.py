@@ -20,6 +20,7 @@ from gateway.goby.dccl.errors import DefinitionError
 from gateway.goby.dccl.field_codec import CodecBase, FieldContext, InlineCodec
 from gateway.goby.dccl.registry import CodecRegistry, MessageCodec
 from gateway.goby.protobuf.include.dccl import option_extensions_pb2 as dccl_options
+from util.descriptors import message_type_of
 
 HEAD, BODY = "head", "body"
 SUPPORTED_VERSION = 3
@@ -147,7 +148,7 @@ class LayoutBuilder:
         if options.HasField("dynamic_conditions"):
             raise self.fail("(dccl.field).dynamic_conditions (DCCL4) are not supported", path)
         repeated = fd.is_repeated
-        is_message = fd.type == FieldDescriptor.TYPE_MESSAGE
+        sub = message_type_of(fd) if fd.type == FieldDescriptor.TYPE_MESSAGE else None
         context = FieldContext(
             descriptor=fd, options=options, message=self.root.full_name, path=path,
             codec_version=self.codec_version, required=fd.is_required or repeated,
@@ -155,13 +156,13 @@ class LayoutBuilder:
         )
         if options.HasField("codec"):
             name = options.codec
-        elif is_message and message_options(fd.message_type).HasField("codec"):
-            name = message_options(fd.message_type).codec
+        elif sub is not None and message_options(sub).HasField("codec"):
+            name = message_options(sub).codec
         else:
             name = self.group
         try:
             found, factory = self.registry.find(fd.type, name, self.codec_version,
-                                                fd.message_type.full_name if is_message else "")
+                                                sub.full_name if sub is not None else "")
         except LookupError as exc:
             raise self.fail(str(exc), path) from None
         layout = FieldLayout(fd, context, found, None, repeated=repeated)
@@ -169,9 +170,8 @@ class LayoutBuilder:
             self.check_repeat(options, path)
             layout.min_repeat, layout.max_repeat = options.min_repeat, options.max_repeat
         if isinstance(factory, MessageCodec):
-            if not is_message:
+            if sub is None:
                 raise self.fail(f"codec `{found}` is for messages", path)
-            sub = fd.message_type
             if sub.full_name in stack:
                 raise self.fail(f"{sub.full_name} contains itself: a recursive message has no maximum size", path)
             child_part = (HEAD if options.in_head else BODY) if options.HasField("in_head") else inherited

@@ -9,10 +9,11 @@ from typing import Any
 
 from google.protobuf.message import Message
 
+from gateway.goby.portal.config import interprocess_config_of
 from gateway.goby.portal.context import start_on_thread
 from gateway.goby.portal.errors import ThreadError
 from gateway.goby.portal.group import Group
-from gateway.goby.portal.thread import SimpleThread, interprocess_config_of
+from gateway.goby.portal.thread import SimpleThread
 
 log = logging.getLogger(__name__)
 
@@ -36,7 +37,7 @@ class _Application(SimpleThread):
     def return_code(self) -> int:
         return self._return_code
 
-    def quit(self, code: int = 0) -> None:  # type: ignore[override]
+    def quit(self, code: int = 0) -> None:
         """Stop the application with exit ``code`` (thread-safe; the first non-zero code wins)."""
         if code and not self._return_code:
             self._return_code = code

@@ -11,6 +11,7 @@ import argparse
 import math
 import os
 import sys
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,6 +21,9 @@ from google.protobuf import message as pb_message
 from google.protobuf import text_format
 
 from gateway.goby.portal.errors import AppConfigError
+from gateway.goby.protobuf.app_config_pb2 import AppConfig
+from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from util.descriptors import descriptor_of, enum_type_of, initialization_errors, message_type_of
 from util.logsetup import add_verbosity_argument
 
 INTERPROCESS_ENV = "GOBY_INTERPROCESS"
@@ -37,6 +41,34 @@ class LoadedConfig:
     verbosity: int
     example_requested: bool
     debug_cfg: bool
+
+
+def _has_field(cfg: Any, name: str) -> bool:
+    descriptor = getattr(cfg, "DESCRIPTOR", None)
+    return descriptor is not None and name in descriptor.fields_by_name
+
+
+def interprocess_config_of(cfg: Any) -> InterProcessPortalConfig | None:
+    """The ``interprocess`` block of an application config, if its type has one (Goby's config types declare it
+    as ``InterProcessPortalConfig``); None for anything else."""
+    if not _has_field(cfg, "interprocess"):
+        return None
+    block: InterProcessPortalConfig = cfg.interprocess
+    return block
+
+
+def app_config_of(cfg: Any) -> AppConfig | None:
+    """The ``app`` block (``AppConfig``) of an application config, if its type has one; None for anything else."""
+    if not _has_field(cfg, "app"):
+        return None
+    block: AppConfig = cfg.app
+    return block
+
+
+def app_name_of(cfg: Any, default: str = "") -> str:
+    """``app.name`` of an application config, or ``default`` when it has no ``app`` block or no name set."""
+    app = app_config_of(cfg)
+    return app.name if app is not None and app.HasField("name") else default
 
 
 def _merge_text(target: pb_message.Message, text: str, where: str) -> None:
@@ -89,8 +121,8 @@ def project_extensions(config_type: type[pb_message.Message]) -> list[pb_descrip
     A config file with them is refused by the real Goby app, so launchers give them on the command line instead,
     ``--<extension name> TEXT`` (as ``--<field>`` for Goby's fields), and the file keeps Goby's fields only.
     """
-    pool = config_type.DESCRIPTOR.file.pool
-    found = pool.FindAllExtensions(config_type.DESCRIPTOR)
+    descriptor = descriptor_of(config_type)
+    found = descriptor.file.pool.FindAllExtensions(descriptor)
     return sorted((e for e in found if not e.full_name.startswith("goby.")), key=lambda e: e.number)
 
 
@@ -98,7 +130,7 @@ def build_parser(config_type: type[pb_message.Message], prog: str | None = None)
     """Goby-style command line: a config file, ``--<top-level field> VALUE`` overrides, ``-e``, ``-v``."""
     parser = argparse.ArgumentParser(
         prog=prog,
-        description=f"Configuration: {config_type.DESCRIPTOR.full_name} in protobuf text format.",
+        description=f"Configuration: {descriptor_of(config_type).full_name} in protobuf text format.",
         epilog="Message fields take text format (e.g. --interprocess 'platform: \"usv\"'); repeat an option to add "
         "to a repeated field.",
     )
@@ -109,7 +141,7 @@ def build_parser(config_type: type[pb_message.Message], prog: str | None = None)
     parser.add_argument("-n", "--ncurses", action="store_true",
                         help="accepted for compatibility with Goby command lines; there is no ncurses GUI (ignored)")
     add_verbosity_argument(parser)
-    for field in config_type.DESCRIPTOR.fields:
+    for field in descriptor_of(config_type).fields:
         kind = "message (text format)" if field.type == _FD.TYPE_MESSAGE else _type_label(field)
         try:
             parser.add_argument(f"--{field.name}", action="append", metavar="VALUE", dest=f"field_{field.name}",
@@ -127,10 +159,10 @@ def build_parser(config_type: type[pb_message.Message], prog: str | None = None)
 
 def load_config(
     config_type: type[pb_message.Message], argv: list[str] | None = None, prog: str | None = None,
-    environ: dict[str, str] | None = None,
+    environ: Mapping[str, str] | None = None,
 ) -> LoadedConfig:
     """Parse ``argv`` into a ``config_type`` message; ``AppConfigError`` names the file/option that is wrong."""
-    environ = os.environ if environ is None else environ
+    env: Mapping[str, str] = os.environ if environ is None else environ
     parser = build_parser(config_type, prog)
     args = parser.parse_args(argv)
     cfg = config_type()
@@ -147,7 +179,7 @@ def load_config(
             raise AppConfigError(f"configuration file {path}: line {line}: not protobuf text format "
                                  f"(byte 0x{exc.object[exc.start]:02x} at offset {exc.start} is not UTF-8)") from None
         _merge_text(cfg, text, f"configuration file {path}")
-    for field in config_type.DESCRIPTOR.fields:
+    for field in descriptor_of(config_type).fields:
         for value in getattr(args, f"field_{field.name}", None) or ():
             if field.type == _FD.TYPE_MESSAGE:
                 target = getattr(cfg, field.name).add() if _is_repeated(field) else getattr(cfg, field.name)
@@ -159,29 +191,33 @@ def load_config(
     for ext in project_extensions(config_type):
         for value in getattr(args, f"ext_{ext.full_name}", None) or ():
             if ext.type == _FD.TYPE_MESSAGE and not _is_repeated(ext):
-                _merge_text(cfg.Extensions[ext], value, f"--{ext.name}")
-                cfg.Extensions[ext].SetInParent()
+                # The stubs index Extensions only by the typed handles generated code declares, not by an
+                # extension found at run time.
+                block: pb_message.Message = cfg.Extensions[ext]  # type: ignore[index]
+                _merge_text(block, value, f"--{ext.name}")
+                block.SetInParent()
             else:
                 _merge_text(cfg, f"[{ext.full_name}]: {value}", f"--{ext.name}")
-    fields = config_type.DESCRIPTOR.fields_by_name
-    if "interprocess" in fields and not cfg.HasField("interprocess") and environ.get(INTERPROCESS_ENV):
-        _merge_text(cfg.interprocess, environ[INTERPROCESS_ENV], f"${INTERPROCESS_ENV}")
-        cfg.interprocess.SetInParent()
-    if "app" in fields:
+    interprocess = interprocess_config_of(cfg)
+    if interprocess is not None and not cfg.HasField("interprocess") and env.get(INTERPROCESS_ENV):
+        _merge_text(interprocess, env[INTERPROCESS_ENV], f"${INTERPROCESS_ENV}")
+        interprocess.SetInParent()
+    app = app_config_of(cfg)
+    if app is not None:
         if args.app_name:
-            cfg.app.name = args.app_name
-        if not cfg.app.HasField("name"):
-            cfg.app.name = prog or os.path.basename(sys.argv[0] or "app")
+            app.name = args.app_name
+        if not app.HasField("name"):
+            app.name = prog or os.path.basename(sys.argv[0] or "app")
     if not cfg.IsInitialized():
-        missing = ", ".join(cfg.FindInitializationErrors())
+        missing = ", ".join(initialization_errors(cfg))
         raise AppConfigError(f"configuration is missing required field(s): {missing}")
     check_values(cfg)
     verbosity = args.verbose
     debug_cfg = False
-    if "app" in fields:
-        if cfg.app.HasField("glog_config") and cfg.app.glog_config.HasField("tty_verbosity"):
-            verbosity = max(verbosity, _TTY_VERBOSITY.get(cfg.app.glog_config.tty_verbosity, 0))
-        debug_cfg = cfg.app.debug_cfg
+    if app is not None:
+        if app.HasField("glog_config") and app.glog_config.HasField("tty_verbosity"):
+            verbosity = max(verbosity, _TTY_VERBOSITY.get(app.glog_config.tty_verbosity, 0))
+        debug_cfg = app.debug_cfg
     return LoadedConfig(cfg, verbosity, False, debug_cfg)
 
 
@@ -228,9 +264,9 @@ _TYPE_NAMES = {
 
 def _type_label(field: pb_descriptor.FieldDescriptor) -> str:
     if field.type == _FD.TYPE_ENUM:
-        return f"enum {field.enum_type.name}"
+        return f"enum {enum_type_of(field).name}"
     if field.type == _FD.TYPE_MESSAGE:
-        return field.message_type.full_name
+        return message_type_of(field).full_name
     return _TYPE_NAMES.get(field.type, "?")
 
 
@@ -238,7 +274,8 @@ def _example_value(field: pb_descriptor.FieldDescriptor) -> str:
     if field.has_default_value or field.type in (_FD.TYPE_ENUM, _FD.TYPE_BOOL):
         value: Any = field.default_value
         if field.type == _FD.TYPE_ENUM:
-            enum_value = field.enum_type.values_by_number.get(value) or field.enum_type.values[0]
+            enum_type = enum_type_of(field)
+            enum_value = enum_type.values_by_number.get(value) or enum_type.values[0]
             return enum_value.name
     else:
         value = {_FD.TYPE_STRING: "", _FD.TYPE_BYTES: b""}.get(field.type, 0)
@@ -259,7 +296,7 @@ def example_config(config_type: type[pb_message.Message] | pb_descriptor.Descrip
     behaviour just by being present are commented out (optional fields without a declared default, repeated
     fields, later members of a oneof, optional blocks that contain required fields).  Required fields stay.
     """
-    descriptor = config_type if isinstance(config_type, pb_descriptor.Descriptor) else config_type.DESCRIPTOR
+    descriptor = config_type if isinstance(config_type, pb_descriptor.Descriptor) else descriptor_of(config_type)
     pad = "  " * _indent
     lines: list[str] = []
     for field in descriptor.fields:
@@ -272,7 +309,7 @@ def example_config(config_type: type[pb_message.Message] | pb_descriptor.Descrip
         if oneof is not None:
             comment += f"; one of {oneof.name}"
         if field.type == _FD.TYPE_MESSAGE:
-            sub = field.message_type
+            sub = message_type_of(field)
             if sub.full_name in _seen or len(_seen) > 6:
                 lines.append(f"{pad}# {field.name} {{ }}  # {comment} (recursive, not expanded)")
                 continue
@@ -297,7 +334,7 @@ def _comment_out(field: pb_descriptor.FieldDescriptor) -> bool:
     if _is_repeated(field):
         return True
     if field.type == _FD.TYPE_MESSAGE:
-        return any(_is_required(sub) for sub in field.message_type.fields)
+        return any(_is_required(sub) for sub in message_type_of(field).fields)
     return not field.has_default_value
 
 

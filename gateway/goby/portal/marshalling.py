@@ -12,8 +12,8 @@ from __future__ import annotations
 import enum
 from typing import TYPE_CHECKING, Any
 
+from google.protobuf import descriptor_pool, message_factory
 from google.protobuf import message as pb_message
-from google.protobuf import message_factory, symbol_database
 
 from gateway.goby.portal.errors import MarshallingError
 
@@ -145,7 +145,7 @@ def parse(data: bytes, scheme: int, msg_type: type, dccl: DcclCodec | None = Non
 def message_class(full_name: str) -> type[pb_message.Message] | None:
     """The generated class for a protobuf full name, if it has been imported in this process."""
     try:
-        descriptor = symbol_database.Default().pool.FindMessageTypeByName(full_name)
+        descriptor = descriptor_pool.Default().FindMessageTypeByName(full_name)
     except KeyError:
         return None
     return message_factory.GetMessageClass(descriptor)

@@ -28,6 +28,6 @@ def parse_monitor_frames(frames: list[bytes]) -> MonitorEvent | None:
     return MonitorEvent(event, value, frames[1])
 
 
-def recv_monitor_event(socket: zmq.Socket, flags: int = 0) -> MonitorEvent | None:  # type: ignore[type-arg]
+def recv_monitor_event(socket: zmq.Socket, flags: int = 0) -> MonitorEvent | None:
     """Receive one monitor message (raises ``zmq.Again`` with NOBLOCK when none is ready)."""
     return parse_monitor_frames(socket.recv_multipart(flags))

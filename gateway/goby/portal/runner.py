@@ -12,10 +12,10 @@ from typing import Any
 
 from google.protobuf import message as pb_message
 
-from gateway.goby.portal.config import load_for_run
+from gateway.goby.portal.config import app_config_of, app_name_of, interprocess_config_of, load_for_run
 from gateway.goby.portal.context import ProcessContext, use_context
 from gateway.goby.portal.errors import StartError
-from gateway.goby.portal.thread import SimpleThread, interprocess_config_of
+from gateway.goby.portal.thread import SimpleThread
 from gateway.goby.portal.timeutil import SystemClock
 from util.extensions import ExtensionError
 from util.logsetup import configure_logging
@@ -26,10 +26,10 @@ log = logging.getLogger(__name__)
 
 def apply_simulation_time(cfg: Any, clock: SystemClock) -> None:
     """Apply ``app.simulation.time`` (use_sim_time, warp_factor, reference_microtime) to ``clock``."""
-    descriptor = getattr(cfg, "DESCRIPTOR", None)
-    if descriptor is None or "app" not in descriptor.fields_by_name:
+    app = app_config_of(cfg)
+    if app is None:
         return
-    sim = cfg.app.simulation.time
+    sim = app.simulation.time
     if sim.use_sim_time:
         reference = sim.reference_microtime if sim.HasField("reference_microtime") else None
         clock.configure(True, sim.warp_factor, reference)
@@ -54,7 +54,7 @@ def run_application(
     if isinstance(loaded, int):
         return loaded
     cfg = loaded.cfg
-    app_name = cfg.app.name if "app" in cfg.DESCRIPTOR.fields_by_name else prog
+    app_name = app_name_of(cfg, prog)  # load_config set app.name if the config type has an app block
     configure_logging(loaded.verbosity, app_name)
     clock = SystemClock()  # this run's clock, owned by its context: nothing process-wide is changed
     apply_simulation_time(cfg, clock)

@@ -29,11 +29,11 @@ from typing import Any
 from google.protobuf import text_format
 
 from gateway.goby.portal.broker import READY_PREFIX
+from gateway.goby.portal.config import app_name_of, interprocess_config_of
 from gateway.goby.portal.context import ProcessContext, use_context
 from gateway.goby.portal.errors import PortalError
 from gateway.goby.portal.group import GroupLike
 from gateway.goby.portal.interprocess import InterProcessPortal
-from gateway.goby.portal.thread import app_name_of, interprocess_config_of
 from gateway.goby.portal.timeutil import SystemClock
 from gateway.goby.portal.transports import ThreadTransports
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig

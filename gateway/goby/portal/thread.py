@@ -12,32 +12,17 @@ import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+from gateway.goby.portal.config import app_name_of, interprocess_config_of
 from gateway.goby.portal.context import ProcessContext, current_context
 from gateway.goby.portal.interprocess import InterProcessPortal
 from gateway.goby.portal.interthread import InterThreadTransporter
 from gateway.goby.portal.transports import ThreadTransports
-from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from util.reactor import Reactor, Timer
 
 if TYPE_CHECKING:
     from gateway.goby.intervehicle.forwarder import InterVehicleForwarder
 
 log = logging.getLogger(__name__)
-
-
-def interprocess_config_of(cfg: Any) -> InterProcessPortalConfig | None:
-    """The ``interprocess`` block of an application config, if its type has one."""
-    descriptor = getattr(cfg, "DESCRIPTOR", None)
-    if descriptor is None or "interprocess" not in descriptor.fields_by_name:
-        return None
-    return cfg.interprocess
-
-
-def app_name_of(cfg: Any, default: str = "") -> str:
-    descriptor = getattr(cfg, "DESCRIPTOR", None)
-    if descriptor is not None and "app" in descriptor.fields_by_name and cfg.app.HasField("name"):
-        return cfg.app.name
-    return default
 
 
 class SimpleThread:

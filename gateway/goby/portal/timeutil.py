@@ -76,7 +76,7 @@ class SystemClock:
 
     def now_datetime(self) -> dt.datetime:
         """Now as an aware UTC ``datetime``."""
-        return micro_to_datetime(self.now_micro())
+        return _EPOCH + dt.timedelta(microseconds=self.now_micro())
 
 
 def micro_to_si(micro: int) -> float:
