@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import os
 import socket
+import subprocess
+import sys
 import threading
 import time
 
@@ -168,3 +170,42 @@ def test_a_timer_weeks_away_does_not_overflow_the_poll(reactor: Reactor) -> None
     assert reactor.run_once() == 1  # the posted work ran; the far timer did not break the poll
     reactor.wake()
     reactor.run_once()
+
+
+def test_a_zmq_socket_added_after_descriptors_keeps_them_watched(reactor: Reactor) -> None:
+    a, b = socket.socketpair()
+    got: list[bytes] = []
+    reactor.add_reader(a, lambda: got.append(a.recv(10)))
+    ctx = zmq.Context.instance()
+    pull = ctx.socket(zmq.PULL)
+    port = pull.bind_to_random_port("tcp://127.0.0.1")
+    push = ctx.socket(zmq.PUSH)
+    push.connect(f"tcp://127.0.0.1:{port}")
+    reactor.add_reader(pull, lambda: got.append(pull.recv(zmq.NOBLOCK)))  # the poller changes kind here
+    b.send(b"fd")
+    push.send(b"zmq")
+    deadline = time.monotonic() + 2
+    while len(got) < 2 and time.monotonic() < deadline:
+        reactor.run_once(timeout_s=0.5)
+    assert sorted(got) == [b"fd", b"zmq"]
+    reactor.remove_reader(pull)
+    reactor.remove_reader(a)
+    push.close(0)
+    pull.close(0)
+    a.close()
+    b.close()
+
+
+def test_a_reactor_on_plain_sockets_does_not_import_zmq() -> None:
+    """pyzmq costs 2.4 MiB of private memory; the MOOS processes and the simulator have no ZeroMQ socket."""
+    code = (
+        "import socket, sys\n"
+        "from util.reactor import Reactor\n"
+        "r = Reactor('plain'); a, b = socket.socketpair(); got = []\n"
+        "r.add_reader(a, lambda: got.append(a.recv(9))); b.send(b'x'); r.call_later(0.0, lambda: None)\n"
+        "r.run_once(1.0); r.close()\n"
+        "assert got == [b'x'], got\n"
+        "print('zmq' in sys.modules)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
+    assert out.stdout.strip() == "False"

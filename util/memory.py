@@ -6,14 +6,15 @@ high after a burst of big buffers is freed; ``malloc_trim(0)`` returns the free 
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import functools
 from collections.abc import Callable
 
 
 @functools.cache
 def _malloc_trim() -> Callable[[int], int] | None:
+    import ctypes  # here, not at the top: 1.7 MiB private in a server that may never drop a big client
+    import ctypes.util
+
     name = ctypes.util.find_library("c")
     try:
         return getattr(ctypes.CDLL(name), "malloc_trim", None) if name else None

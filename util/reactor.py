@@ -1,7 +1,7 @@
 """The one way a thread waits: a reactor over ZeroMQ sockets, file descriptors, timers and cross-thread posts.
 
 Every long-running thread of the project owns one ``Reactor`` and sleeps in exactly one place, its poll
-(``zmq.Poller``, which takes ZeroMQ sockets and plain descriptors alike).  It wakes only when a registered source is
+(``select.poll`` over descriptors; ``zmq.Poller`` from the first ZeroMQ socket on, which takes both).  It wakes only when a registered source is
 ready, a timer is due, or another thread posts work through the ``Mailbox`` eventfd: nothing polls on a period when
 there is nothing to do.  Loops that Goby or MOOS run at a fixed rate (AppTick, the frontseat interface's 10 Hz loop,
 TDMA slots) are ``call_every`` timers.  Why not asyncio: the hot paths are ZeroMQ sockets and small blocking-free
@@ -19,18 +19,22 @@ import itertools
 import logging
 import math
 import os
+import select
+import sys
 import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol, TypeAlias
 
-import zmq
+if TYPE_CHECKING:
+    import zmq
 
 log = logging.getLogger(__name__)
 
-READ = zmq.POLLIN
-WRITE = zmq.POLLOUT
+READ = 1  # zmq.POLLIN
+WRITE = 2  # zmq.POLLOUT
+_ERROR = 4  # zmq.POLLERR
 MAX_WAIT_S = 3600.0
 
 
@@ -42,15 +46,50 @@ class _HasFileno(Protocol):
     def fileno(self) -> int: ...
 
 
-Source = zmq.Socket | int | _HasFileno
+Source: TypeAlias = "zmq.Socket | int | _HasFileno"
 Handler = Callable[[], object]
+
+
+def _is_zmq_socket(source: object) -> bool:
+    zmq_module = sys.modules.get("zmq")  # no ZeroMQ socket can exist before zmq is imported
+    return zmq_module is not None and isinstance(source, zmq_module.Socket)
 
 
 def _key(source: Source) -> zmq.Socket | int:
     """What the poller reports a source as: the zmq socket itself, else its descriptor number."""
-    if isinstance(source, (zmq.Socket, int)):
-        return source
+    if isinstance(source, int) or _is_zmq_socket(source):
+        return source  # type: ignore[return-value]  # narrowed by _is_zmq_socket
     return source.fileno()
+
+
+class _DescriptorPoller:
+    """``select.poll`` with ``zmq.Poller``'s interface and flags, for a reactor with no ZeroMQ socket.
+
+    Why: importing pyzmq costs 2.4 MiB of private memory, and the MOOS processes and the frontseat simulator wait
+    on plain sockets only.
+    """
+
+    _TO_SELECT = {READ: select.POLLIN, WRITE: select.POLLOUT}
+
+    def __init__(self) -> None:
+        self._poll = select.poll()
+
+    def register(self, fd: int, mask: int) -> None:
+        events = select.POLLIN if mask & READ else 0
+        events |= select.POLLOUT if mask & WRITE else 0
+        self._poll.register(fd, events)
+
+    def unregister(self, fd: int) -> None:
+        self._poll.unregister(fd)
+
+    def poll(self, timeout_ms: int | None) -> list[tuple[int, int]]:
+        ready = []
+        for fd, events in self._poll.poll(timeout_ms):
+            mask = READ if events & (select.POLLIN | select.POLLHUP) else 0
+            mask |= WRITE if events & select.POLLOUT else 0
+            mask |= _ERROR if events & (select.POLLERR | select.POLLNVAL) else 0
+            ready.append((fd, mask))
+        return ready
 
 
 class Mailbox:
@@ -175,8 +214,8 @@ class Reactor:
     def __init__(self, name: str = "", closed_error: Callable[[str], Exception] = ReactorClosedError) -> None:
         self.name = name
         self.mailbox = Mailbox(name, closed_error)
-        self._poller = zmq.Poller()
-        self._poller.register(self.mailbox.fd, zmq.POLLIN)
+        self._poller: Any = _DescriptorPoller()
+        self._poller.register(self.mailbox.fd, READ)
         self._readers: dict[Any, Handler] = {}
         self._writers: dict[Any, Handler] = {}
         self._masks: dict[Any, int] = {}
@@ -221,11 +260,23 @@ class Reactor:
             self._set_mask(key, self._masks.get(key, 0) & ~WRITE)
 
     def _set_mask(self, source: zmq.Socket | int, mask: int) -> None:
+        if mask and isinstance(self._poller, _DescriptorPoller) and not isinstance(source, int):
+            self._use_zmq_poller()
         if mask:
             self._masks[source] = mask
             self._poller.register(source, mask)
         elif self._masks.pop(source, None) is not None:
             self._poller.unregister(source)
+
+    def _use_zmq_poller(self) -> None:
+        """The first ZeroMQ socket: move every registration to a ``zmq.Poller``, which polls both kinds."""
+        import zmq
+
+        poller = zmq.Poller()
+        poller.register(self.mailbox.fd, READ)
+        for source, mask in self._masks.items():
+            poller.register(source, mask)
+        self._poller = poller
 
     # -------------------------------------------------------------------------------- timers
     def call_at(self, deadline: float, fn: Handler) -> Timer:
@@ -323,7 +374,7 @@ class Reactor:
                 handler = self._writers.get(source)
                 if handler is not None:
                     events += self._call(handler)
-            if ready & zmq.POLLERR and source not in self._readers and source not in self._writers:
+            if ready & _ERROR and source not in self._readers and source not in self._writers:
                 self._set_mask(source, 0)
         events += self._run_due_timers(time.monotonic())
         return events
