@@ -16,7 +16,7 @@ frontseat tree needs no import of the translators built on top of it.
 from __future__ import annotations
 
 from collections.abc import Callable
-from types import ModuleType
+from types import MappingProxyType, ModuleType
 
 from frontseat.driver import FrontSeatDriver
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
@@ -27,9 +27,12 @@ ENV_VAR = "FRONTSEAT_DRIVER_LIBRARY"
 FACTORY_NAME = "frontseat_driver_load"
 
 DRIVER_POINT = ExtensionPoint(group="goby_frontseat.drivers", what="frontseat driver library", source=ENV_VAR,
-                              library_prefix="goby_frontseat_")
+                              library_prefix="goby_frontseat_",
+                              builtin=MappingProxyType({"basic_simulator": "frontseat.basic_simulator_driver"}))
 HELM_INTERFACE_POINT = ExtensionPoint(group="goby_frontseat.helm_interfaces", what="helm interface",
-                                      source="[goby.moos.protobuf.moos_helm]", entry_points_only=True)
+                                      source="[goby.moos.protobuf.moos_helm]", entry_points_only=True,
+                                      builtin=MappingProxyType(
+                                          {"moos_helm": "translators.frontseat.translation:FrontSeatTranslation"}))
 MOOS_HELM = "moos_helm"
 
 DriverFactory = Callable[[config_pb.Config], FrontSeatDriver]

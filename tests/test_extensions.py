@@ -121,3 +121,30 @@ def test_module_checks(installed: Path) -> None:
     not_callable.load = 3  # type: ignore[attr-defined]
     with pytest.raises(ExtensionError, match="Function load in test extension: x is not callable"):
         module_function(POINT, "x", not_callable, "load")
+
+
+def test_builtin_names_are_the_installed_entry_points_and_load_without_package_metadata() -> None:
+    """The project's own extensions are found without importlib.metadata (MiBs per process); the table must say
+    exactly what pyproject.toml's entry points say."""
+    import importlib.metadata
+    import subprocess
+
+    from frontseat.loading import DRIVER_POINT, HELM_INTERFACE_POINT
+    from gateway.moos_gateway.plugins import PLUGIN_POINT
+
+    for point in (DRIVER_POINT, HELM_INTERFACE_POINT, PLUGIN_POINT):
+        installed = {ep.name: ep.value for ep in importlib.metadata.entry_points(group=point.group)}
+        assert point.builtin, point.group
+        for name, target in point.builtin.items():
+            assert installed.get(name) == target, (point.group, name)
+    code = ("import sys\nfrom frontseat.loading import load_driver_library, helm_interface_class\n"
+            "load_driver_library('libgoby_frontseat_basic_simulator.so.30'); helm_interface_class()\n"
+            "print('importlib.metadata' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_a_broken_builtin_is_reported_naming_it() -> None:
+    point = ExtensionPoint(group="test.none", what="widget", builtin=MappingProxyType({"w": "no_such_mod_xyz:W"}))
+    with pytest.raises(ExtensionError, match="Failed to open widget: w, reason: built-in no_such_mod_xyz:W"):
+        load_extension(point, "w")

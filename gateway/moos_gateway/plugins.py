@@ -34,6 +34,10 @@ PLUGIN_POINT = ExtensionPoint(
     # Goby3's shared-library names for the plugins we re-implement (without "lib" and ".so...")
     aliases=MappingProxyType({"goby_ivp_frontseat_moos_gateway_plugin": "frontseat",
                               "goby3_course_moos_gateway_plugin": "goby3_course"}),
+    builtin=MappingProxyType({"frontseat": "translators.frontseat.translation",
+                              "usv_command": "translators.usv.command_translation",
+                              "node_report": "translators.node_report",
+                              "goby3_course": "translators.trail.gateway_plugin"}),
 )
 
 
