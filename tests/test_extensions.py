@@ -146,5 +146,5 @@ def test_builtin_names_are_the_installed_entry_points_and_load_without_package_m
 
 def test_a_broken_builtin_is_reported_naming_it() -> None:
     point = ExtensionPoint(group="test.none", what="widget", builtin=MappingProxyType({"w": "no_such_mod_xyz:W"}))
-    with pytest.raises(ExtensionError, match="Failed to open widget: w, reason: built-in no_such_mod_xyz:W"):
+    with pytest.raises(ExtensionError, match="Failed to open widget: w, reason: entry point w = no_such_mod_xyz:W: ModuleNotFoundError"):
         load_extension(point, "w")

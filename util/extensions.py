@@ -116,7 +116,7 @@ def load_extension(point: ExtensionPoint, spec: str) -> Any:
     for candidate in point._candidate_names(spec):
         target = point.builtin.get(candidate)
         if target is not None:
-            return _load_builtin(point, spec, target)
+            return _load_builtin(point, spec, candidate, target)
     entry_point = point.entry_point(spec)
     if entry_point is not None:
         try:
@@ -139,14 +139,15 @@ def load_extension(point: ExtensionPoint, spec: str) -> Any:
         raise point.error(spec, f"{type(exc).__name__}: {exc}{_known(point) if missing else ''}") from exc
 
 
-def _load_builtin(point: ExtensionPoint, spec: str, target: str) -> Any:
+def _load_builtin(point: ExtensionPoint, spec: str, name: str, target: str) -> Any:
+    """Import a built-in extension; a failure reads as its entry point's would (the table mirrors them)."""
     module_name, _, attribute = target.partition(":")
     try:
         loaded: Any = importlib.import_module(module_name)
         for part in filter(None, attribute.split(".")):
             loaded = getattr(loaded, part)
     except Exception as exc:
-        raise point.error(spec, f"built-in {target}: {type(exc).__name__}: {exc}") from exc
+        raise point.error(spec, f"entry point {name} = {target}: {type(exc).__name__}: {exc}") from exc
     return loaded
 
 
