@@ -1,9 +1,14 @@
-"""Active queues: per-variable callbacks that run on their own thread (``CMOOSCommClient::AddActiveQueue``)."""
+"""Active queues: per-variable callbacks (``CMOOSCommClient::AddActiveQueue``), run on the client's reactor thread.
+
+libMOOS gives each queue a thread; here a routed message is handed to its queue's callback on the client's I/O
+thread (its reactor) as the packet is delivered, in arrival order, before the on-mail callback. A callback that
+needs its own thread posts the message to one. Routes may be changed from any thread: the tables are replaced,
+never changed in place, so the reactor reads them without a lock.
+"""
 
 from __future__ import annotations
 
 import logging
-import queue
 import threading
 from collections.abc import Callable
 
@@ -13,62 +18,27 @@ from .wildcard import wild_match
 log = logging.getLogger(__name__)
 
 MessageCallback = Callable[[MoosMessage], object]
-
-_STOP = object()
-
-
-class ActiveQueue:
-    """One queue and the thread that calls ``callback(msg)`` for each message pushed to it, in order."""
-
-    def __init__(self, name: str, callback: MessageCallback, owner: str = "") -> None:
-        self.name = name
-        self._callback = callback
-        self._queue: queue.SimpleQueue[object] = queue.SimpleQueue()
-        self._thread = threading.Thread(
-            target=self._run, name=f"moos-active-queue-{owner}-{name}", daemon=True
-        )
-        self._thread.start()
-
-    def push(self, msg: MoosMessage) -> None:
-        self._queue.put(msg)
-
-    def stop(self, timeout: float = 5.0) -> None:
-        """Let the queue finish what it holds, then end its thread; idempotent."""
-        if self._thread.is_alive():
-            self._queue.put(_STOP)
-            if threading.current_thread() is not self._thread:
-                self._thread.join(timeout)
-
-    def _run(self) -> None:
-        while True:
-            item = self._queue.get()
-            if item is _STOP:
-                return
-            try:
-                self._callback(item)  # type: ignore[arg-type]
-            except Exception:
-                log.exception("active queue %r: callback raised; carrying on", self.name)
+Routes = dict[bytes, frozenset[str]]
 
 
 class ActiveQueueRouter:
-    """Maps variable names (and wildcard patterns) to active queues; used by the client's reader thread."""
+    """Maps variable names (and wildcard patterns) to named callbacks; ``dispatch`` runs on the reactor thread."""
 
-    def __init__(self, owner: str = "") -> None:
-        self._owner = owner
-        self._lock = threading.Lock()
-        self._queues: dict[str, ActiveQueue] = {}
-        self._routes: dict[bytes, set[str]] = {}
-        self._wild_routes: dict[bytes, set[str]] = {}
+    def __init__(self) -> None:
+        self._lock = threading.Lock()  # serialises writers; readers use whatever table is current
+        self._queues: dict[str, MessageCallback] = {}
+        self._routes: Routes = {}
+        self._wild_routes: Routes = {}
 
     def __bool__(self) -> bool:
         return bool(self._routes or self._wild_routes)
 
     def add_queue(self, name: str, callback: MessageCallback) -> bool:
-        """Create queue ``name`` (its callback runs on the queue's own thread); False if it exists."""
+        """Create queue ``name``; False if it exists."""
         with self._lock:
             if name in self._queues:
                 return False
-            self._queues[name] = ActiveQueue(name, callback, self._owner)
+            self._queues = {**self._queues, name: callback}
             return True
 
     def has_queue(self, name: str) -> bool:
@@ -79,63 +49,75 @@ class ActiveQueueRouter:
         with self._lock:
             if name not in self._queues:
                 return False
-            table = self._wild_routes if wildcard else self._routes
-            table.setdefault(key, set()).add(name)
+            table = dict(self._wild_routes if wildcard else self._routes)
+            table[key] = table.get(key, frozenset()) | {name}
+            if wildcard:
+                self._wild_routes = table
+            else:
+                self._routes = table
             return True
 
     def remove_route(self, name: str, key: bytes) -> bool:
         with self._lock:
-            found = False
-            for table in (self._routes, self._wild_routes):
-                names = table.get(key)
-                if names and name in names:
-                    names.discard(name)
-                    if not names:
-                        del table[key]
-                    found = True
-            return found
+            routes, found_plain = _without(self._routes, name, key)
+            wild, found_wild = _without(self._wild_routes, name, key)
+            self._routes, self._wild_routes = routes, wild
+            return found_plain or found_wild
 
     def remove_queue(self, name: str) -> bool:
         with self._lock:
-            q = self._queues.pop(name, None)
-            for table in (self._routes, self._wild_routes):
-                for key in [k for k, names in table.items() if name in names]:
-                    table[key].discard(name)
-                    if not table[key]:
-                        del table[key]
-        if q is None:
-            return False
-        q.stop()
-        return True
+            if name not in self._queues:
+                return False
+            self._queues = {k: v for k, v in self._queues.items() if k != name}
+            self._routes = _drop_queue(self._routes, name)
+            self._wild_routes = _drop_queue(self._wild_routes, name)
+            return True
 
     def describe(self) -> str:
-        with self._lock:
-            lines = [f"{key.decode(errors='replace')} -> {sorted(names)}" for key, names in self._routes.items()]
-            lines += [f"{key.decode(errors='replace')} (wildcard) -> {sorted(names)}" for key, names in self._wild_routes.items()]
+        lines = [f"{key.decode(errors='replace')} -> {sorted(names)}" for key, names in self._routes.items()]
+        lines += [f"{key.decode(errors='replace')} (wildcard) -> {sorted(names)}"
+                  for key, names in self._wild_routes.items()]
         return "\n".join(lines)
 
     def dispatch(self, msg: MoosMessage) -> bool:
-        """Push a notification to every queue it is routed to; True if it went to at least one."""
+        """Call every queue ``msg`` is routed to (on this thread); True if it went to at least one."""
         targets = self._routes.get(msg.raw_key)
-        if self._wild_routes:
-            wild = {n for pat, names in self._wild_routes.items() if wild_match(pat, msg.raw_key) for n in names}
-            targets = (targets or set()) | wild
+        wild_routes = self._wild_routes
+        if wild_routes:
+            wild = {n for pattern, names in wild_routes.items() if wild_match(pattern, msg.raw_key) for n in names}
+            targets = (targets or frozenset()) | wild
         if not targets:
             return False
         queues = self._queues
         delivered = False
-        for name in targets:
-            q = queues.get(name)
-            if q is not None:
-                q.push(msg)
-                delivered = True
+        for name in sorted(targets) if len(targets) > 1 else targets:
+            callback = queues.get(name)
+            if callback is None:
+                continue
+            delivered = True
+            try:
+                callback(msg)
+            except Exception:
+                log.exception("active queue %r: callback raised; carrying on", name)
         return delivered
 
-    def stop_all(self) -> None:
+    def clear(self) -> None:
         with self._lock:
-            queues = list(self._queues.values())
-            self._queues.clear()
-            self._routes.clear()
-            self._wild_routes.clear()
-        for q in queues:
-            q.stop()
+            self._queues, self._routes, self._wild_routes = {}, {}, {}
+
+
+def _without(table: Routes, name: str, key: bytes) -> tuple[Routes, bool]:
+    names = table.get(key)
+    if not names or name not in names:
+        return table, False
+    copy = dict(table)
+    rest = names - {name}
+    if rest:
+        copy[key] = rest
+    else:
+        del copy[key]
+    return copy, True
+
+
+def _drop_queue(table: Routes, name: str) -> Routes:
+    return {key: names - {name} for key, names in table.items() if names - {name}}

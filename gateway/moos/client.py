@@ -1,15 +1,16 @@
 """``comms``: a pure-Python MOOS v10 client with pymoos's API (asynchronous by default, synchronous on request).
 
-This module is the API; the threads, the outgoing queue and the incoming path live in ``engine.py``.
-Callbacks: on-connect, on-disconnect and on-mail run on the client's I/O thread; active-queue callbacks on
-their queue's own thread.
+This module is the API; the reactor work (connection, outgoing queue, incoming path) lives in ``engine.py``.
+Callbacks (on-connect, on-disconnect, on-mail, active queues, on-undelivered) run on the client's I/O thread: the
+thread of its reactor, its own ``moos-comms-<name>`` thread, or with ``comms(reactor=r)`` the thread that runs ``r``.
 """
 
 from __future__ import annotations
 
 import logging
-import threading
 import time as _time
+
+from util.reactor import Reactor
 
 from .active_queue import MessageCallback
 from .clock import DEFAULT_CLOCK, MoosClock
@@ -44,14 +45,23 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
     ``comms()`` is asynchronous like pymoos; ``comms(asynchronous=False)`` speaks the synchronous protocol;
     ``clock=`` gives it its own :class:`MoosClock` (warp, and the skew learned from the DB); without it the client
     shares the process-wide ``DEFAULT_CLOCK`` with ``gateway.moos.time()``, as libMOOS clients do.
+
+    ``reactor=r`` (our extension; pymoos has no such argument): the client lives on a :class:`util.reactor.Reactor`
+    its user already runs and has no thread of its own. Its socket and timers are registered on ``r``; every
+    callback runs on ``r``'s thread; ``run()`` starts connecting and returns at once; ``r``'s thread never blocks
+    waiting for the DB (``wait_until_connected`` and ``server_request`` raise MoosError there instead of waiting,
+    see their docstrings). Without it the client runs its own reactor on a ``moos-comms-<name>`` thread.
     """
 
-    def __init__(self, asynchronous: bool = True, clock: MoosClock | None = None) -> None:
-        super().__init__(asynchronous, clock if clock is not None else DEFAULT_CLOCK)
+    def __init__(self, asynchronous: bool = True, clock: MoosClock | None = None, *,
+                 reactor: Reactor | None = None) -> None:
+        super().__init__(asynchronous, clock if clock is not None else DEFAULT_CLOCK, reactor)
 
     # ---- lifecycle ---------------------------------------------------------------------------------
     def run(self, server: str, port: int, name: str, comms_tick: float = 5) -> bool:
-        """Start connecting to the DB at ``server:port`` as ``name``; returns at once (False if running)."""
+        """Start connecting to the DB at ``server:port`` as ``name``; returns at once (False if running).
+
+        May be called on any thread; with ``comms(reactor=r)`` the connection is made by ``r``'s thread."""
         with self._lock:
             if self._running:
                 return False
@@ -60,12 +70,14 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
         self._src = to_bytes(name)
         if comms_tick:
             self.set_comms_tick(comms_tick)
-        self._start_threads()
+        self._start()
         return True
 
     def close(self, nice: bool = True) -> bool:
-        """Stop the client: with ``nice`` first wait (up to 2 s) for queued messages to be sent. Idempotent."""
-        self._stop_threads(nice)
+        """Stop the client: with ``nice`` first wait (up to 2 s) until what is queued is written and confirmed by the
+        DB; anything not confirmed is reported undelivered (docs/moos.md "Restarts"). Idempotent; from any thread
+        (on the client's own reactor thread the wait is done there, reading only the DB's confirmations)."""
+        self._stop(nice)
         self._registered.clear()
         self._wildcards.clear()
         return True
@@ -78,25 +90,28 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
 
     # ---- callbacks ---------------------------------------------------------------------------------
     def set_on_connect_callback(self, func: Callback) -> bool:
-        """``func()`` runs on the client's I/O thread after every (re)connection; register there."""
+        """``func()`` runs on the client's I/O (reactor) thread after every (re)connection; register there."""
         self._on_connect = func
         return True
 
     def set_on_disconnect_callback(self, func: Callback) -> bool:
-        """``func()`` runs on the client's I/O thread when the connection is lost."""
+        """``func()`` runs on the client's I/O (reactor) thread when the connection is lost (and at ``close``)."""
         self._on_disconnect = func
         return True
 
     def set_on_mail_callback(self, func: Callback) -> bool:
-        """``func()`` runs on the client's I/O thread after mail arrives; it should only wake its owner,
-        which then calls :meth:`fetch` on its own thread (or call ``fetch`` right there, as pymoos scripts do)."""
+        """``func()`` runs on the client's I/O (reactor) thread after mail arrives (once per read, however many
+        packets it held); it should only wake its owner, which then calls :meth:`fetch` on its own thread (or call
+        ``fetch`` right there, as pymoos scripts do: posts made in the callback leave as one packet when it
+        returns)."""
         self._on_mail = func
         return True
 
     def set_on_undelivered_callback(self, func: UndeliveredCallback) -> bool:
         """Extension (pymoos has none): ``func(messages)`` gets the messages ``notify`` accepted that may not
         have reached the DB: written but unconfirmed when the connection was lost, or discarded by ``close``.
-        Runs on the comms I/O thread (or the thread calling ``close``). See docs/moos.md "Restarts"."""
+        Runs on the client's I/O (reactor) thread (or the thread calling ``close`` once the reactor is gone).
+        See docs/moos.md "Restarts"."""
         self._on_undelivered = func
         return True
 
@@ -105,7 +120,8 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
 
     # ---- active queues -----------------------------------------------------------------------------
     def add_active_queue(self, queue_name: str, func: MessageCallback) -> bool:
-        """Create a queue whose ``func(msg)`` runs on the queue's own thread, once per routed message."""
+        """Create a queue whose ``func(msg)`` runs once per routed message, in order, on the client's I/O (reactor)
+        thread as the packet is delivered (libMOOS gives each queue a thread; post to one if you need it)."""
         return self._queues.add_queue(queue_name, func)
 
     def add_message_route_to_active_queue(self, queue_name: str, msg_name: str) -> bool:
@@ -114,7 +130,7 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
 
     def add_wildcard_active_queue(self, queue_name: str, pattern: str, func: MessageCallback) -> bool:
         """Route every notification whose name matches the MOOS wildcard ``pattern`` to queue ``queue_name``
-        (created if needed); ``func(msg)`` runs on the queue's own thread."""
+        (created if needed); ``func(msg)`` runs on the client's I/O (reactor) thread."""
         if not self._queues.has_queue(queue_name):
             self._queues.add_queue(queue_name, func)
         return self._queues.add_route(queue_name, to_bytes(pattern), wildcard=True)
@@ -227,8 +243,9 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
         Replies (id -2) are taken out of the inbox; other mail stays for ``fetch``. The DB sends all replies
         to one request in one packet, so this returns as soon as they arrive (or ``[]`` after ``timeout``).
         """
-        if threading.get_ident() == self._io_ident:
-            raise MoosError("server_request() waits for the I/O thread, so it cannot run in a comms callback")
+        if self._on_io_thread():
+            raise MoosError("server_request() waits for the client's reactor thread, so it cannot run on it (in a "
+                            "comms callback, or on the reactor given with comms(reactor=...))")
         msg = MoosMessage(SERVER_REQUEST, STRING, msg_id=SERVER_REQUEST_ID, key=to_bytes(what), msg_time=self._clock.time())
         if not self._post(msg, assign_id=False):
             return []
@@ -249,20 +266,23 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
     # ---- reading mail ------------------------------------------------------------------------------
     def fetch(self) -> list[MoosMessage]:
         """All mail received since the last fetch, in arrival order (thread-safe)."""
-        with self._inbox_cond:
-            if not self._inbox:
-                return []
-            mail = list(self._inbox)
-            self._inbox.clear()
-            self._inbox_cond.notify_all()
-        return mail
+        return self._fetch_all()
 
     # ---- state -------------------------------------------------------------------------------------
     def is_connected(self) -> bool:
         return self._live
 
     def wait_until_connected(self, n_ms: float) -> bool:
-        """Block until connected or ``n_ms`` milliseconds pass."""
+        """Block until connected or ``n_ms`` milliseconds pass.
+
+        On the client's own reactor thread (a callback, or the reactor given with ``comms(reactor=r)``), which is
+        the thread that would connect it, it never blocks: True when connected, False when ``n_ms <= 0``, else
+        MoosError (use the on-connect callback there instead)."""
+        if self._on_io_thread():
+            if self._live or n_ms <= 0:
+                return self._live
+            raise MoosError("wait_until_connected() on the client's own reactor thread would block the thread that "
+                            "connects it; use set_on_connect_callback() (or is_connected()) there")
         return self._connected.wait(max(0.0, n_ms) / 1000.0)
 
     def is_running(self) -> bool:
@@ -300,10 +320,10 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
         return len(self._outbox)
 
     def get_number_bytes_sent(self) -> int:
-        return self._bytes_sent_total + (self._conn.bytes_sent if self._conn else 0)
+        return self._bytes_sent
 
     def get_number_bytes_read(self) -> int:
-        return self._bytes_read_total + (self._conn.bytes_read if self._conn else 0)
+        return self._bytes_read
 
     def get_number_of_refused_messages(self) -> int:
         """Extension: posts that returned False because the client was not connected (pymoos drops them)."""
@@ -353,7 +373,7 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
         self._outbox_limit = max(1, int(limit))
 
     def set_inbox_limit(self, limit: int) -> None:
-        """Unfetched messages before the reader stops reading (back-pressure instead of a silent purge)."""
+        """Unfetched messages before the client stops reading (back-pressure instead of a silent purge)."""
         self._inbox_limit = max(1, int(limit))
 
     def _reregister(self) -> None:

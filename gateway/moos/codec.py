@@ -80,10 +80,13 @@ def encode_message(msg: MoosMessage) -> bytes:
     )
 
 
-def frame_packet(encoded_messages: list[bytes]) -> bytes:
-    """Wrap already-encoded messages into one packet (lets a server encode a message once for many peers)."""
+def frame_packet(encoded_messages: list[bytes], count: int | None = None) -> bytes:
+    """Wrap already-encoded messages into one packet (lets a server encode a message once for many peers).
+
+    ``count`` is the number of messages when an element holds several (a run forwarded as received)."""
     body = b"".join(encoded_messages)
-    return _pack_pkt_head(PACKET_HEADER_SIZE + len(body), len(encoded_messages), 0) + body
+    n = len(encoded_messages) if count is None else count
+    return _pack_pkt_head(PACKET_HEADER_SIZE + len(body), n, 0) + body
 
 
 def encode_packet(messages: list[MoosMessage]) -> bytes:
@@ -143,7 +146,7 @@ def decode_packet_body(buf: bytes, pos: int, total: int) -> list[MoosMessage]:
     if count < 0 or count * MESSAGE_FIXED_SIZE > total - PACKET_HEADER_SIZE:
         raise ProtocolError(f"packet of {total} bytes cannot hold {count} messages")
     p = pos + PACKET_HEADER_SIZE
-    messages = []
+    messages: list[MoosMessage] = []
     append = messages.append
     # Fast path: messages in a packet usually share their src/aux/community/key lengths, so the previous
     # message's layout is tried first as one compiled struct. It is only accepted when every length field it
@@ -203,6 +206,27 @@ class PacketReader:
 
     def feed(self, data: bytes | bytearray | memoryview) -> list[list[MoosMessage]]:
         """Add bytes; return the list of complete packets now available, each a list of messages."""
+        error: ProtocolError | None = None
+        try:
+            raw = self.feed_raw(data)
+        except ProtocolError as exc:
+            raw, error = exc.packets, exc
+        good: list[list[MoosMessage]] = []
+        try:
+            for region, pos, total in raw:
+                good.append(decode_packet_body(region, pos, total))
+        except ProtocolError as exc:
+            exc.packets = good
+            raise
+        if error is not None:
+            error.packets = good
+            raise error
+        return good
+
+    def feed_raw(self, data: bytes | bytearray | memoryview) -> list[tuple[bytes, int, int]]:
+        """Add bytes; return the complete packets now available undecoded: ``(region, start, total)`` each, the
+        packet being ``region[start:start + total]`` (all share one region: one copy). ``packet_count`` reads a
+        packet's message count; ``decode_packet_body`` decodes it."""
         buf = self._buf
         buf += data
         size = len(buf)
@@ -219,23 +243,27 @@ class PacketReader:
                     break
                 end += total
         except ProtocolError as exc:
-            exc.packets = self._decode_region(end) if end else []
+            exc.packets = self._take_region(end) if end else []
             raise
-        return self._decode_region(end) if end else []
+        return self._take_region(end) if end else []
 
-    def _decode_region(self, end: int) -> list[list[MoosMessage]]:
-        """Decode the whole packets in ``_buf[:end]`` and drop them from the buffer."""
+    def _take_region(self, end: int) -> list[tuple[bytes, int, int]]:
+        """The whole packets in ``_buf[:end]``, dropped from the buffer."""
         with memoryview(self._buf) as view:
             region = bytes(view[:end])  # one copy (slicing the bytearray first would make two)
         del self._buf[:end]
         packets = []
         pos = 0
-        try:
-            while pos < end:
-                (total,) = _unpack_i32(region, pos)
-                packets.append(decode_packet_body(region, pos, total))
-                pos += total
-        except ProtocolError as exc:
-            exc.packets = packets
-            raise
+        while pos < end:
+            (total,) = _unpack_i32(region, pos)
+            packets.append((region, pos, total))
+            pos += total
         return packets
+
+
+def packet_count(region: bytes, pos: int, total: int) -> int:
+    """The message count in the header of the packet at ``region[pos:pos + total]``; ProtocolError if impossible."""
+    _, count, _compressed = _unpack_pkt_head(region, pos)
+    if count < 0 or count * MESSAGE_FIXED_SIZE > total - PACKET_HEADER_SIZE:
+        raise ProtocolError(f"packet of {total} bytes cannot hold {count} messages")
+    return int(count)

@@ -38,6 +38,17 @@ log = logging.getLogger(__name__)
 SUMMARY_PERIOD_S = 2.0
 
 
+class HeldMail:
+    """Encoded messages held for one client: chunks of wire bytes (each one message, or a run of them forwarded
+    as received) and how many messages they hold, so they are framed as one packet without re-encoding."""
+
+    __slots__ = ("chunks", "count")
+
+    def __init__(self) -> None:
+        self.chunks: list[bytes] = []
+        self.count = 0
+
+
 class DBVar:
     """One variable (CMOOSDBVar)."""
 
@@ -111,12 +122,14 @@ class MoosDatabase:
         self.limits = DBLimits(max_variables, max_variables_per_client, max_name_bytes, max_stored_bytes)
         self.vars: dict[bytes, DBVar] = {}
         self.clients: dict[bytes, bool] = {}  # name -> asynchronous, in connection order
-        self.held: dict[bytes, list[bytes]] = {}
+        self.held: dict[bytes, HeldMail] = {}
         self.mail_waiting: set[bytes] = set()
         self.filters: dict[bytes, dict[tuple[bytes, bytes], float]] = {}
         self.qos: dict[bytes, list[float]] = {}  # name -> [recent, max, min, sum, count] in ms
         self.rejected_writes = 0  # writes refused by the type lock
         self._write_seq = 0
+        self.rw_version = 0  # bumped when who subscribes to or has written what changes (PROC_SUMMARY's cache)
+        self.rw_cache: tuple[int, dict[bytes, list[bytes]], dict[bytes, list[bytes]]] | None = None
         self._jobs = JobQueue(self._hold_wire)
         self._summaries_running = False
         now = self.clock.time()
@@ -150,7 +163,7 @@ class MoosDatabase:
     # ---- clients -----------------------------------------------------------------------------------
     def connect(self, name: bytes, asynchronous: bool) -> None:
         self.clients[name] = asynchronous
-        self.held[name] = []
+        self.held[name] = HeldMail()
         self._internal_notify(b"DB_EVENT", b"connected=" + name)
 
     def disconnect(self, name: bytes) -> None:
@@ -159,20 +172,23 @@ class MoosDatabase:
             return
         for var in self.vars.values():
             var.subscribers.pop(name, None)
+        self.rw_version += 1
         self.filters.pop(name, None)
         self.held.pop(name, None)
         self.mail_waiting.discard(name)
         self.qos.pop(name, None)
         self._internal_notify(b"DB_EVENT", b"disconnected=" + name)
 
-    def take_mail(self, name: bytes) -> list[bytes]:
-        """Remove and return the encoded messages held for ``name``, in the order they were queued."""
+    def take_mail(self, name: bytes) -> tuple[list[bytes], int]:
+        """Remove and return the mail held for ``name`` in the order it was queued: (wire chunks, message count);
+        ``frame_packet(chunks, count)`` makes it a packet."""
         self.mail_waiting.discard(name)
         box = self.held.get(name)
-        if not box:
-            return []
-        self.held[name] = []
-        return box
+        if box is None or not box.count:
+            return [], 0
+        chunks, count = box.chunks, box.count
+        box.chunks, box.count = [], 0
+        return chunks, count
 
     def record_timing(self, name: bytes, latency_ms: float) -> None:
         stats = self.qos.get(name)
@@ -193,29 +209,34 @@ class MoosDatabase:
         ``client`` is the connection that sent them: caps are charged to it (default: each message's ``src``).
         Server requests that need more than ``JOB_SLICE_S`` finish later; their replies are then held as mail.
         """
-        replies: list[MoosMessage] = []
-        had_notify = False
         now = self.clock.time()
+        had_notify = False
         for msg in messages:
-            kind = msg.msg_type
-            if kind == NOTIFY:  # the common case first; the rest are rare (registrations, server requests)
-                self.notify(msg, now, client)
-                had_notify = True
-            elif kind == msg_kinds.REGISTER:
-                self.register(msg.raw_src, msg.raw_key, msg.dval, client)
-            elif kind == msg_kinds.UNREGISTER:
-                self.unregister(msg.raw_src, msg.raw_key)
-            elif kind == msg_kinds.WILDCARD_REGISTER:
-                self.wildcard_register(msg.raw_src, *parse_filter(msg.raw_sval))
-            elif kind == msg_kinds.WILDCARD_UNREGISTER:
-                app, var, _ = parse_filter(msg.raw_sval)
-                self.wildcard_unregister(msg.raw_src, app, var)
-            elif kind == msg_kinds.SERVER_REQUEST:
-                self._start_request(msg, client if client is not None else msg.raw_src)
+            had_notify |= msg.msg_type == NOTIFY
+            self.process_one(msg, now, client)
+        return self.end_of_packet(now), had_notify
+
+    def process_one(self, msg: MoosMessage, now: float, client: bytes | None = None) -> None:
+        """Apply one message of a packet (``db_wire.process_wire`` calls this for all but runs of notifications)."""
+        kind = msg.msg_type
+        if kind == NOTIFY:  # the common case first; the rest are rare (registrations, server requests)
+            self.notify(msg, now, client)
+        elif kind == msg_kinds.REGISTER:
+            self.register(msg.raw_src, msg.raw_key, msg.dval, client)
+        elif kind == msg_kinds.UNREGISTER:
+            self.unregister(msg.raw_src, msg.raw_key)
+        elif kind == msg_kinds.WILDCARD_REGISTER:
+            self.wildcard_register(msg.raw_src, *parse_filter(msg.raw_sval))
+        elif kind == msg_kinds.WILDCARD_UNREGISTER:
+            app, var, _ = parse_filter(msg.raw_sval)
+            self.wildcard_unregister(msg.raw_src, app, var)
+        elif kind == msg_kinds.SERVER_REQUEST:
+            self._start_request(msg, client if client is not None else msg.raw_src)
+
+    def end_of_packet(self, now: float) -> list[MoosMessage]:
+        """After a packet: the DB_* summaries when due, and the replies of requests that fit one slice."""
         self.maybe_publish_summaries(now)
-        if self._jobs.has_new:
-            replies = self._jobs.run_new()
-        return replies, had_notify
+        return self._jobs.run_new() if self._jobs.has_new else []
 
     def notify(self, msg: MoosMessage, now: float | None = None, client: bytes | None = None) -> bool:
         """``OnNotify``: store, type-lock, fan out to due subscribers. False when refused (type lock, caps)."""
@@ -252,6 +273,7 @@ class MoosDatabase:
                 for (app, pattern), period in filters.items():
                     if wild_match(app, msg.raw_src) and wild_match(pattern, key):
                         var.subscribers[filter_owner] = [period, 0.0]
+                        self.rw_version += 1
         limits.stored_bytes -= len(var.aux) + len(var.writer) + len(var.community) + len(var.sval)
         var.written_time = now
         var.msg_time = msg.msg_time
@@ -265,10 +287,19 @@ class MoosDatabase:
         else:
             var.sval = msg.raw_sval
         limits.stored_bytes += len(var.aux) + len(var.writer) + len(var.community) + len(var.sval)
-        var.writers.add(msg.raw_src)
+        if msg.raw_src not in var.writers:
+            var.writers.add(msg.raw_src)
+            self.rw_version += 1
+        self.count_writes(var, 1, now)
+        if var.subscribers:
+            msg.msg_type = NOTIFY
+            wire = encode_message(msg)
+            self.fan_out(var, wire, 1, wire, now)
+        return True
+
+    def count_writes(self, var: DBVar, n: int, now: float) -> None:
+        """``n`` writes to ``var`` at ``now``: write count, the DB's write sequence, the write frequency."""
         var.written += 1
-        self._write_seq += 1
-        var.seq = self._write_seq
         dt = now - var.stats_time
         if dt > 0.5:
             if dt > 10.0:
@@ -276,20 +307,32 @@ class MoosDatabase:
             else:
                 var.write_freq = 0.5 * var.write_freq + 0.5 / (dt / (var.written - var.stats_writes))
             var.stats_writes, var.stats_time = var.written, now
-        subscribers = var.subscribers
-        if subscribers:
-            msg.msg_type = NOTIFY
-            wire = encode_message(msg)
-            held = self.held
-            waiting = self.mail_waiting
-            for subscriber, info in subscribers.items():
-                if info[0] == 0.0 or now - info[1] >= info[0]:
-                    box = held.get(subscriber)
-                    if box is not None:
-                        box.append(wire)
-                        waiting.add(subscriber)
-                        info[1] = now
-        return True
+        var.written += n - 1  # the rest came at the same ``now``: the estimate would not change again
+        self._write_seq += n
+        var.seq = self._write_seq
+
+    def fan_out(self, var: DBVar, wire: bytes, n: int, first: bytes, now: float) -> None:
+        """Hold ``n`` notifications of ``var`` (``wire``, the first alone ``first``) for its due subscribers: all
+        for those registered with interval 0, else the first if the interval has passed (``now`` is one time for
+        all ``n``, so at most one is due)."""
+        held = self.held
+        waiting = self.mail_waiting
+        for subscriber, info in var.subscribers.items():
+            period = info[0]
+            if period == 0.0:
+                box = held.get(subscriber)
+                if box is not None:
+                    box.chunks.append(wire)
+                    box.count += n
+                    waiting.add(subscriber)
+                    info[1] = now
+            elif now - info[1] >= period:
+                box = held.get(subscriber)
+                if box is not None:
+                    box.chunks.append(first)
+                    box.count += 1
+                    waiting.add(subscriber)
+                    info[1] = now
 
     def register(self, client: bytes, key: bytes, period: float, sender: bytes | None = None) -> None:
         """``OnRegister``: (re)subscribe with ``period``; queue the current value if the variable was written."""
@@ -303,6 +346,8 @@ class MoosDatabase:
                 return
             var = self.vars[key] = DBVar(key, NOT_SET)
             self.limits.stored_bytes += len(key)
+        if client not in var.subscribers:
+            self.rw_version += 1
         var.subscribers[client] = [max(0.0, period), 0.0]
         if var.written:
             self._hold(client, var.as_message())
@@ -310,8 +355,8 @@ class MoosDatabase:
 
     def unregister(self, client: bytes, key: bytes) -> None:
         var = self.vars.get(key)
-        if var is not None:
-            var.subscribers.pop(client, None)
+        if var is not None and var.subscribers.pop(client, None) is not None:
+            self.rw_version += 1
 
     def wildcard_register(self, client: bytes, app: bytes, pattern: bytes, period: float) -> None:
         """Store the filter (first period wins, as C++'s set does) and register every matching variable."""
@@ -327,12 +372,14 @@ class MoosDatabase:
         """Unsubscribe matching variables. As in C++ the stored filter stays (new variables still match)."""
         for var in self.vars.values():
             if wild_match(app, var.writer) and wild_match(pattern, var.name):
-                var.subscribers.pop(client, None)
+                if var.subscribers.pop(client, None) is not None:
+                    self.rw_version += 1
 
     def _hold(self, client: bytes, msg: MoosMessage) -> None:
         box = self.held.get(client)
         if box is not None:
-            box.append(encode_message(msg))
+            box.chunks.append(encode_message(msg))
+            box.count += 1
             self.mail_waiting.add(client)
 
     def _internal_notify(self, key: bytes, value: bytes | float) -> None:
@@ -347,13 +394,15 @@ class MoosDatabase:
         """Hold encoded messages for ``client`` all at once (one request's replies go in one packet)."""
         box = self.held.get(client)
         if box is not None:
-            box.extend(wire)
+            box.chunks.extend(wire)
+            box.count += len(wire)
             self.mail_waiting.add(client)
 
     def _forget(self, var: DBVar) -> None:
         """DB_CLEAR of one variable: its value, writers and write count go; subscriptions stay."""
         self.limits.stored_bytes -= len(var.aux) + len(var.writer) + len(var.community) + len(var.sval)
         var.reset()
+        self.rw_version += 1
 
     # ---- jobs (db_jobs.py) -------------------------------------------------------------------------
     @property
@@ -395,7 +444,7 @@ class MoosDatabase:
             log.warning("DB_CLEAR requested by %s: resetting %d variables and all held mail",
                         preview(msg.raw_src), len(self.vars))
             for client in self.held:
-                self.held[client] = []
+                self.held[client] = HeldMail()
             self.mail_waiting.clear()
             self.start_time = self.clock.time()
             return db_jobs.clear_steps(self.vars, self._write_seq, self._forget)
@@ -432,7 +481,7 @@ class MoosDatabase:
         try:
             text = yield from db_jobs.var_summary_steps(self.vars)
             self._internal_notify(b"DB_VARSUMMARY", text)
-            text = yield from db_jobs.rw_summary_steps(self.vars, self.clients)
+            text = yield from db_jobs.rw_summary_steps(self)
             self._internal_notify(b"DB_RWSUMMARY", text)
         finally:
             self._summaries_running = False
@@ -440,7 +489,7 @@ class MoosDatabase:
 
     def rw_summary(self) -> bytes:
         """``client=sub1:sub2&pub1:pub2,...`` for every connected client."""
-        return drain(db_jobs.rw_summary_steps(self.vars, self.clients))
+        return drain(db_jobs.rw_summary_steps(self))
 
     def var_summary(self) -> bytes:
         """The DB_VARSUMMARY table: one padded line per variable, as CMOOSDB::UpdateSummaryVar prints it."""

@@ -121,7 +121,7 @@ def drain(steps: Generator[None, None, T]) -> T:
         try:
             next(steps)
         except StopIteration as done:
-            return done.value  # type: ignore[no-any-return]
+            return done.value
 
 
 # ---- walking the variables in name order ----------------------------------------------------------------
@@ -160,6 +160,20 @@ def rw_lists(variables: Mapping[bytes, DBVar]
     return subs, pubs
 
 
+def cached_rw_lists(db: MoosDatabase
+                    ) -> Generator[None, None, tuple[dict[bytes, list[bytes]], dict[bytes, list[bytes]]]]:
+    """:func:`rw_lists` of the DB's variables, reused while no subscription or writer changed (``rw_version``):
+    a publishing client asks for PROC_SUMMARY every second, and the answer rarely changes."""
+    cache = db.rw_cache
+    if cache is not None and cache[0] == db.rw_version:
+        return cache[1], cache[2]
+    version = db.rw_version
+    subs, pubs = yield from rw_lists(db.vars)
+    if db.rw_version == version:
+        db.rw_cache = (version, subs, pubs)
+    return subs, pubs
+
+
 # ---- server requests ------------------------------------------------------------------------------------
 def all_steps(db: MoosDatabase, msg: MoosMessage) -> Steps:
     """``ALL``: every variable as a notification, times relative to the DB's start."""
@@ -191,7 +205,7 @@ def var_names_steps(db: MoosDatabase, msg: MoosMessage) -> Steps:
 
 def proc_summary_steps(db: MoosDatabase, msg: MoosMessage) -> Steps:
     """``PROC_SUMMARY``: one ``client:SUBSCRIBED=,A,B,PUBLISHED=,X`` line per connected client."""
-    subs, pubs = yield from rw_lists(db.vars)
+    subs, pubs = yield from cached_rw_lists(db)
     now = db.clock.time()
     replies = []
     for client in db.clients:
@@ -217,11 +231,11 @@ def clear_steps(variables: Mapping[bytes, DBVar], up_to: int, forget: Callable[[
 
 
 # ---- DB_* summaries -------------------------------------------------------------------------------------
-def rw_summary_steps(variables: Mapping[bytes, DBVar], clients: Iterable[bytes]) -> Generator[None, None, bytes]:
+def rw_summary_steps(db: MoosDatabase) -> Generator[None, None, bytes]:
     """``DB_RWSUMMARY``: ``client=sub1:sub2&pub1:pub2,...`` for every connected client."""
-    subs, pubs = yield from rw_lists(variables)
+    subs, pubs = yield from cached_rw_lists(db)
     return cut(b",".join(client + b"=" + b":".join(subs.get(client, ())) + b"&" + b":".join(pubs.get(client, ()))
-                         for client in clients))
+                         for client in db.clients))
 
 
 def var_summary_steps(variables: Mapping[bytes, DBVar]) -> Generator[None, None, bytes]:

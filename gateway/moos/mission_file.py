@@ -9,6 +9,7 @@ printable) is refused, naming file and line: libMOOS would read it as an empty m
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import os
@@ -89,7 +90,7 @@ class MissionFile:
             line = _strip_comment(line).strip()
             if not line:
                 continue
-            line = _REFERENCE.sub(lambda m, n=number: self._lookup(m.group(1), defines, n), line)
+            line = _REFERENCE.sub(functools.partial(self._substitute, defines=defines, number=number), line)
             match = _DEFINE.match(line)
             if match:
                 defines[match.group(1)] = match.group(2).strip()
@@ -97,6 +98,9 @@ class MissionFile:
             lines.append(line)
             numbers.append(number)
         return lines, numbers
+
+    def _substitute(self, match: re.Match[str], defines: dict[str, str], number: int) -> str:
+        return self._lookup(match.group(1), defines, number)
 
     def _lookup(self, name: str, defines: dict[str, str], number: int) -> str:
         if name in defines:
@@ -199,7 +203,7 @@ class MissionFile:
             where = f"{self.path}:{self._numbers[i]}"
             if i + 1 >= len(lines) or not lines[i + 1].startswith("{"):
                 raise MissionFileError(f"{where}: 'ProcessConfig = {app}' is not followed by '{{'")
-            body = []
+            body: list[str] = []
             for inner in lines[i + 2 :]:
                 if inner.startswith("}"):
                     return body

@@ -1,7 +1,7 @@
 """One connection accepted by ``MoosDB`` (``server.py``): its state and buffers, and when it must be dropped.
 
 Plain state and decisions, no socket calls: the server's one I/O thread creates these, reads and writes through
-them and asks :func:`timeout_reason` about each one periodically.
+them, asks :func:`deadline` when the next one could time out and, then, :func:`timeout_reason` whether it did.
 """
 
 from __future__ import annotations
@@ -51,3 +51,13 @@ def timeout_reason(client: ServerClient, now: float, handshake_timeout: float, s
     elif now - client.last_rx > client_timeout:
         return f"disconnecting after {client_timeout:g} seconds of silence"
     return None
+
+
+def deadline(client: ServerClient, handshake_timeout: float, stall_timeout: float, client_timeout: float) -> float:
+    """When (monotonic) ``client`` times out if nothing changes meanwhile: :func:`timeout_reason`'s earliest."""
+    if client.state in (PROTOCOL, HELLO):
+        return client.accepted + handshake_timeout
+    when = client.last_rx + client_timeout
+    if client.out_bytes:
+        when = min(when, client.last_progress + stall_timeout)
+    return when

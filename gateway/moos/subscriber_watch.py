@@ -2,15 +2,16 @@
 
 A confirmed message reaches the clients registered for it *when the DB processed it*, so after a DB restart a post
 written before its subscribers have registered again is lost to them. A publishing client therefore asks the DB
-every ``SUMMARY_PERIOD_S`` which clients subscribe to what (``PROC_SUMMARY``, as uMS does). When the link goes
-down, each variable we publish that others subscribed to becomes *missing*; after the reconnection its posts are
+every ``SUMMARY_PERIOD_S`` which clients subscribe to what (``PROC_SUMMARY``, as uMS does; an asynchronous client
+asks in the packet of its once-a-second timing message, so the question costs no packet or wake-up of its own).
+When the link goes down, each variable we publish that others subscribed to becomes *missing*; after the reconnection its posts are
 refused and its queued mail is held until the DB lists those subscribers again (asked every
 ``RESUBSCRIBE_POLL_S``), or until ``RESUBSCRIBE_WAIT_S`` has passed: then they are taken to be gone.
 
 :class:`SubscriberWatch` only decides: it is given ``now``, the encoded outbox and the parsed summaries, and returns
 what to send, hold or release; the engine does the I/O and logging. Not thread-safe: ``ClientEngine`` calls it
-under its lock, from whichever of its threads is writing (the I/O thread, the writer thread, or an application
-thread writing directly) and, for replies, from the I/O thread.
+under its lock, from whichever thread is writing (its reactor thread, or an application thread writing directly)
+and, for replies, from its reactor thread.
 """
 
 from __future__ import annotations

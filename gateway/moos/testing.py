@@ -189,6 +189,7 @@ def collect_mail(
     Works with our ``comms`` and the real pymoos (do not also fetch from an on-mail callback).
     """
     wanted = set(names) if names is not None else None
+    done: Callable[[list[MoosMessage]], bool]
     if until is None:
         def done(got: list[MoosMessage]) -> bool:
             return wanted is None or wanted <= {m.key() for m in got}

@@ -190,7 +190,7 @@ def test_callbacks_run_on_the_io_thread_and_fetch_gets_mail(db_port: int) -> Non
         client.close(True)
 
 
-def test_active_queue_gets_routed_mail_on_its_own_thread(db_port: int) -> None:
+def test_active_queue_gets_routed_mail_on_the_io_thread(db_port: int) -> None:
     seen: list[tuple[str, float, str]] = []
     done = threading.Event()
 
@@ -210,7 +210,7 @@ def test_active_queue_gets_routed_mail_on_its_own_thread(db_port: int) -> None:
         pub.notify("AQ_OTHER", 9.0)
         assert done.wait(10)
         assert [(k, v) for k, v, _ in seen] == [("AQ_VAR", 0.0), ("AQ_VAR", 1.0), ("AQ_VAR", 2.0)]
-        assert all(name.startswith("moos-active-queue") for _, _, name in seen)
+        assert all(name == "moos-comms-aq" for _, _, name in seen)  # the client's I/O thread, in order
         assert [m.key() for m in collect_mail(c, ["AQ_VAR", "AQ_OTHER"], until=1)] == ["AQ_OTHER"]
         assert c.remove_active_queue("q1") and not c.has_active_queue("q1")
 

@@ -49,8 +49,8 @@ def db(clock: ManualClock) -> MoosDatabase:
 
 
 def mail(db: MoosDatabase, who: bytes = b"sub") -> list[MoosMessage]:
-    box = db.take_mail(who)
-    return decode_packet(frame_packet(box)) if box else []
+    chunks, count = db.take_mail(who)
+    return decode_packet(frame_packet(chunks, count)) if count else []
 
 
 def notify(db: MoosDatabase, key: str, value: float | str | bytes, src: bytes = b"pub", t: float = 5.0) -> None:
@@ -223,7 +223,7 @@ def test_db_clear_resets_values_and_mail(db: MoosDatabase) -> None:
     register(db, "C")
     notify(db, "C", 1.0)
     db.process([MoosMessage(SERVER_REQUEST, STRING, -2, src=b"sub", key=b"DB_CLEAR")])
-    assert db.take_mail(b"sub") == []
+    assert db.take_mail(b"sub") == ([], 0)
     notify(db, "C", "now a string")  # the type is learned again
     assert [m.string() for m in mail(db)] == ["now a string"]
 

@@ -7,10 +7,11 @@ import time
 from collections.abc import Generator
 
 from gateway.moos import db_jobs
+from gateway.moos.clock import MoosClock
 from gateway.moos.codec import decode_packet, frame_packet
-from gateway.moos.database import DBVar
+from gateway.moos.database import DBVar, MoosDatabase
 from gateway.moos.db_jobs import JOB_SLICE_S, SORT_RUN, JobQueue, Steps, drain
-from gateway.moos.message import DOUBLE, NOTIFY, STRING, MoosMessage
+from gateway.moos.message import DOUBLE, NOTIFY, REGISTER, SERVER_REQUEST, STRING, UNREGISTER, MoosMessage
 
 
 def steps_of(gen: Generator[None, None, object]) -> tuple[int, object]:
@@ -100,12 +101,23 @@ def test_db_clear_spares_variables_written_after_the_request() -> None:
     assert forgotten == [b"OLD"]
 
 
-def test_rw_summary_names_subscriptions_and_writes_in_name_order() -> None:
-    variables = {name: DBVar(name, DOUBLE) for name in (b"B", b"A", b"C")}
-    variables[b"B"].subscribers[b"x"] = [0.0, 0.0]
-    variables[b"A"].subscribers[b"x"] = [0.0, 0.0]
-    variables[b"C"].writers.add(b"x")
-    assert drain(db_jobs.rw_summary_steps(variables, [b"x", b"y"])) == b"x=A:B&C,y=&"
+def test_rw_summary_names_subscriptions_and_writes_in_name_order_and_its_cache_follows_changes() -> None:
+    db = MoosDatabase("c", MoosClock())
+    for name in (b"x", b"y"):
+        db.connect(name, True)
+    db.process([MoosMessage(REGISTER, DOUBLE, 1, src=b"x", key=b"B"), MoosMessage(REGISTER, DOUBLE, 2, src=b"x", key=b"A"),
+                MoosMessage(NOTIFY, DOUBLE, 3, src=b"x", key=b"C", dval=1.0)], b"x")
+    assert drain(db_jobs.rw_summary_steps(db)) == b"x=A:B&C,y=&"
+    db.process([MoosMessage(NOTIFY, DOUBLE, 4, src=b"x", key=b"C", dval=2.0)], b"x")  # nothing new: cached
+    assert db.rw_cache is not None and db.rw_cache[0] == db.rw_version
+    db.process([MoosMessage(REGISTER, DOUBLE, 5, src=b"y", key=b"C")], b"y")
+    assert drain(db_jobs.rw_summary_steps(db)) == b"x=A:B&C,y=C&"
+    db.process([MoosMessage(NOTIFY, DOUBLE, 6, src=b"y", key=b"A", dval=1.0)], b"y")
+    db.process([MoosMessage(UNREGISTER, DOUBLE, 7, src=b"x", key=b"B")], b"x")
+    assert drain(db_jobs.rw_summary_steps(db)) == b"x=A&C,y=C&A"
+    db.disconnect(b"y")
+    procs = [m.string() for m in db.server_request(MoosMessage(SERVER_REQUEST, STRING, -2, key=b"PROC_SUMMARY"))]
+    assert procs == ["x:SUBSCRIBED=,A,PUBLISHED=,C"]
 
 
 def test_summary_line_shortens_long_strings() -> None:

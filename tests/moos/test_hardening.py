@@ -100,7 +100,7 @@ def test_requests_over_many_variables_never_hold_the_db_for_long() -> None:
         gc.enable()
     assert worst < 0.05, f"one call held the DB for {worst * 1000:.0f} ms of CPU"
     from gateway.moos.codec import decode_packet, frame_packet
-    got = decode_packet(frame_packet(db.take_mail(b"b")))
+    got = decode_packet(frame_packet(*db.take_mail(b"b")))
     procs = [m.string() for m in got if m.key() == "PROC_SUMMARY"]
     assert "a:SUBSCRIBED=,V0000007,PUBLISHED=" in procs and len(procs) == 3
     assert sum(1 for m in got if m.key().startswith("V0")) == 60_000  # ALL, in one packet
@@ -139,14 +139,14 @@ def test_a_huge_request_does_not_stall_or_drop_good_clients(tmp_path: Path) -> N
 def test_a_busy_db_does_not_blame_its_stall_on_a_quiet_client() -> None:
     """The loop is held 4 s by one packet; a client whose heartbeat waited in the kernel is not dropped."""
     with running_moosdb(client_timeout=2.0) as db:
-        real_process = db.db.process
+        real_notify = db.db.notify
 
-        def stalling(messages: list[MoosMessage], client: bytes | None = None):  # type: ignore[no-untyped-def]
-            if any(m.raw_key == b"STALL" for m in messages):
+        def stalling(msg: MoosMessage, now: float | None = None, client: bytes | None = None) -> bool:
+            if msg.raw_key == b"STALL":
                 time.sleep(4.0)
-            return real_process(messages, client)
+            return real_notify(msg, now, client)
 
-        db.db.process = stalling  # type: ignore[method-assign]
+        db.db.notify = stalling  # type: ignore[method-assign]
         with connected_comms(db.port, "alice", ["AFTER"]) as alice, connected_comms(db.port, "staller") as staller:
             staller.notify("STALL", 1.0)
             time.sleep(5.0)
