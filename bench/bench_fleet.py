@@ -26,6 +26,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from bench.platform_proc import children_by_parent, subtree
 from launch.errors import LaunchError
 from launch.trail.links import LinkMonitor
 from launch.trail.mission import TrailMission, with_free_ports
@@ -33,29 +34,6 @@ from launch.trail.settings import TrailSettings
 
 CLK_TCK = os.sysconf("SC_CLK_TCK")
 PAGE = os.sysconf("SC_PAGE_SIZE")
-
-
-def _children() -> dict[int, list[int]]:
-    tree: dict[int, list[int]] = {}
-    for entry in os.listdir("/proc"):
-        if not entry.isdigit():
-            continue
-        try:
-            stat = Path(f"/proc/{entry}/stat").read_text()
-        except OSError:
-            continue
-        ppid = int(stat.rsplit(")", 1)[1].split()[1])
-        tree.setdefault(ppid, []).append(int(entry))
-    return tree
-
-
-def _subtree(root: int, tree: dict[int, list[int]]) -> list[int]:
-    out, todo = [], [root]
-    while todo:
-        pid = todo.pop()
-        out.append(pid)
-        todo.extend(tree.get(pid, []))
-    return out
 
 
 def _program(pid: int) -> str:
@@ -143,8 +121,8 @@ def measure(n_auvs: int, warp: int, sim_seconds: float) -> dict[str, object]:
         row["startup_s"] = time.monotonic() - started
         assert mission.group is not None
         roots = {p.name: p.pid for p in mission.group.processes}
-        tree = _children()
-        all0 = [pid for root in roots.values() for pid in _subtree(root, tree)]
+        tree = children_by_parent()
+        all0 = [pid for root in roots.values() for pid in subtree(root, tree)]
         since = _uptime()
         pids0 = _cpu_by_pid(all0)
         programs0 = _cpu_by_program(all0)
@@ -153,11 +131,11 @@ def measure(n_auvs: int, warp: int, sim_seconds: float) -> dict[str, object]:
         mission.run(None, until=lambda: mission.now() - sim0 >= sim_seconds)
         real, sim, machine1 = time.monotonic() - real0, mission.now() - sim0, _machine_ticks()
         row["machine_busy"] = (machine1[0] - machine0[0]) / max(1e-9, machine1[1] - machine0[1])
-        tree = _children()
-        per_platform = {name: _cpu_and_rss(_subtree(pid, tree)) for name, pid in roots.items()}
-        programs = _cpu_by_program([pid for root in roots.values() for pid in _subtree(root, tree)])
+        tree = children_by_parent()
+        per_platform = {name: _cpu_and_rss(subtree(pid, tree)) for name, pid in roots.items()}
+        programs = _cpu_by_program([pid for root in roots.values() for pid in subtree(root, tree)])
         row["programs"] = {k: (v - programs0.get(k, 0.0)) / sim for k, v in programs.items()}
-        all1 = [pid for root in roots.values() for pid in _subtree(root, tree)]
+        all1 = [pid for root in roots.values() for pid in subtree(root, tree)]
         cpu = _cpu_delta(pids0, _cpu_by_pid(all1), since)
         row["cpu_per_sim_s"] = cpu / sim
         row["core_share"] = cpu / real / (os.cpu_count() or 1)
