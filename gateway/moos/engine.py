@@ -164,6 +164,7 @@ class ClientEngine:
         self._wildcards: dict[tuple[str, str], float] = {}
         self._reregistered: set[tuple[str, float]] = set()
         self._published: set[str] = set()
+        self._asked_about = 0  # how many of _published the last PROC_SUMMARY request covered
         self._on_connect: Callback | None = None
         self._on_disconnect: Callback | None = None
         self._on_mail: Callback | None = None
@@ -971,10 +972,15 @@ class ClientEngine:
     def _summary_request(self, now: float, timed: bool) -> bytes | None:
         """Under the lock: a ``PROC_SUMMARY`` request when one is due (we publish something), else None; gives up
         waiting for subscribers that have not come back within ``RESUBSCRIBE_WAIT_S``. An async client asks in the
-        packet of its once-a-second timing message (``timed``), or while it waits for subscribers."""
-        if not self._published or (self._async and not timed and not self._watch.missing):
+        packet of its once-a-second timing message (``timed``), in the first packet that publishes a variable it has
+        not asked about (so that a drop within the first second of publishing still finds its subscribers known), or
+        while it waits for subscribers."""
+        first_publication = len(self._published) != self._asked_about
+        if not self._published or (self._async and not timed and not first_publication and not self._watch.missing):
             return None
-        poll = self._watch.poll(now, True)
+        poll = self._watch.poll(now, True, first_publication)
+        if poll.ask:
+            self._asked_about = len(self._published)
         if poll.gave_up:
             log.warning("%s: subscriber(s) of %s did not register again within %.1f s of reconnecting; publishing "
                         "to those variables again", self._name,

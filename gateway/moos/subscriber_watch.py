@@ -106,15 +106,17 @@ class SubscriberWatch:
                 keep.append(encoded)
         return keep
 
-    def poll(self, now: float, publishing: bool) -> Poll:
-        """Whether a request is due (only while we publish something); gives up waiting past ``missing_until``."""
+    def poll(self, now: float, publishing: bool, first_publication: bool = False) -> Poll:
+        """Whether a request is due (only while we publish something): every period, and at once when we publish a
+        variable the DB has not been asked about (its subscribers must be known before a drop can come); gives up
+        waiting past ``missing_until``."""
         decision = Poll()
         if self.missing and now >= self.missing_until:
             decision.gave_up = frozenset(self.missing)
             self.missing.clear()
             decision.release = self._take_held()
         period = RESUBSCRIBE_POLL_S if self.missing else SUMMARY_PERIOD_S
-        if publishing and now - self.last_request >= period:
+        if publishing and (first_publication or now - self.last_request >= period):
             self.last_request = now
             self.pending = True
             decision.ask = True
