@@ -61,8 +61,7 @@ def main(argv: list[str] | None = None) -> int:
             info = {"platform": cfg.interprocess.platform, **broker.endpoints(), "pid": os.getpid()}
             print(READY_PREFIX + json.dumps(info), flush=True)
             log.info("=== goby-broker is ready ===")
-            while not stop.wait(1.0):
-                pass
+            stop.wait()  # no timeout: the signal handler sets it (an idle broker's main thread never wakes)
             return 0
         finally:
             broker.stop()

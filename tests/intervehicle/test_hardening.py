@@ -184,7 +184,7 @@ def test_failed_link_thread_is_reported_and_restarted(tmp_path: Path, caplog: py
     made: list[EtherDriver] = []
 
     class FailsOnce(EtherDriver):
-        """The first driver raises out of the link's loop (a bug anywhere in the link looks like this)."""
+        """The first driver raises when it reads a datagram (a bug anywhere in the link looks like this)."""
 
         def do_work(self) -> None:
             super().do_work()
@@ -207,7 +207,9 @@ def test_failed_link_thread_is_reported_and_restarted(tmp_path: Path, caplog: py
         portal = IntervehiclePortal(cfg, context, driver_factory=factory)
         try:
             portal.start()
-            wait_until(lambda: portal.running[0].restarts == 1 and portal.running[0].thread.alive, 10,
+            # the first datagram the first driver reads makes it raise
+            ether.send(ModemTransmission(src=1, dest=2, type=ModemTransmission.DATA).SerializeToString())
+            wait_until(lambda: portal.running[0].restarts == 1 and portal.running[0].up, 10,
                        "the failed link to be restarted")
             errors = [r.getMessage() for r in caplog.records if r.levelno == logging.ERROR]
             assert any(m.startswith("intervehicle link 2 failed (RuntimeError: injected fault); restarting it")
@@ -227,7 +229,7 @@ def test_failed_link_thread_is_reported_and_restarted(tmp_path: Path, caplog: py
             portal.stop()
             context.close()
             ether.detach(-1)
-    assert not any(t.name.startswith("intervehicle-link") for t in threading.enumerate())
+    assert not any(t.name.startswith("intervehicle") for t in threading.enumerate())
 
 
 # -- 2. forged frames from another host ----------------------------------------------------------------------

@@ -1,7 +1,8 @@
 """Goby3's ``DynamicBuffer``: per-destination, per-(group, DCCL id) priority queues for the intervehicle links.
 
 Pure logic: every method takes ``now`` (warped seconds, Goby's SteadyClock under warp), so tests drive time by
-hand and the link thread passes its warped clock. Rules follow Goby3 ``src/acomms/buffer/dynamic_buffer.h``:
+hand and the broker's intervehicle thread passes its warped clock. Rules follow Goby3
+``src/acomms/buffer/dynamic_buffer.h``:
 
 - config merge over all subscriber and publisher configs: ``ack_required`` and ``newest_first`` true wins,
   smallest ``blackout_time``, largest ``max_queue``, mean ``ttl`` and ``value_base``, proto defaults otherwise;
@@ -139,6 +140,14 @@ class DynamicSubBuffer:
                 expired.append(self._values.popleft())
         return expired
 
+    def next_expiry(self) -> float | None:
+        """When ``expire`` next removes a value (the oldest one's ``push_time + ttl``; ``expire`` takes it once
+        ``now`` is past that), or None when empty."""
+        if not self._values:
+            return None
+        oldest = self._values[-1] if self.cfg.newest_first else self._values[0]
+        return oldest.push_time + self.cfg.ttl
+
     def erase(self, value: Value) -> bool:
         """Remove ``value`` (by identity); False if it is no longer here."""
         for i, held in enumerate(self._values):
@@ -225,6 +234,11 @@ class DynamicBuffer:
         if subs is None or buffer_id not in subs:
             return False
         return subs[buffer_id].erase(value)
+
+    def next_expiry(self) -> float | None:
+        """The earliest ``next_expiry`` of the sub-buffers (warped s), or None when every one is empty."""
+        times = [t for subs in self._subs.values() for sub in subs.values() if (t := sub.next_expiry()) is not None]
+        return min(times, default=None)
 
     def expire(self, now: float) -> list[tuple[int, Hashable, Value]]:
         """Remove every value past its ttl; returns (dest, buffer_id, value) for each."""

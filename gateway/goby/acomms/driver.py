@@ -3,7 +3,9 @@
 Goby's API: ``startup(cfg)``, ``shutdown()``, ``do_work()``, ``handle_initiate_transmission(msg)``, and signals
 ``signal_data_request`` (fill the frames of our transmission), ``signal_receive`` (every transmission heard, data
 and acks), ``signal_transmit_result`` (what was sent). All run on the thread that calls ``do_work`` and
-``handle_initiate_transmission`` (the link's thread).
+``handle_initiate_transmission`` (the broker's intervehicle thread). Ours adds ``fileno()``: a descriptor that is
+readable whenever ``do_work`` has something to read, so the link calls ``do_work`` only then (Goby calls it at
+10 Hz warped whether anything arrived or not).
 
 :class:`DatagramDriver` owns the behaviour of Goby's UDP multicast driver (``udp_multicast_driver.cpp``): the
 running frame counter, ``max_frame_bytes`` from the slot (else ``rate_to_bytes``, else ``max_frame_size``),
@@ -64,6 +66,7 @@ class ModemDriver(abc.ABC):
         self.peers: frozenset[int] | None = None  # wire ids we ack data from (None: any)
         self.max_frames = 1  # frames (and acked frames) one transmission may carry on this link
         self.name = ""  # for log lines: which link this driver serves (default: "modem <id>")
+        self.refusals = RateLimitedLog(log, REFUSED_LOG_PERIOD_S)  # what it refused; the link flushes held lines
 
     def expect(self, name: str, peers: Collection[int] | None, max_frames: int) -> None:
         """What the link allows (call before ``startup``): the wire ids of its peers (None: any) and the most
@@ -81,8 +84,13 @@ class ModemDriver(abc.ABC):
         """Close the link; idempotent."""
 
     @abc.abstractmethod
+    def fileno(self) -> int:
+        """A descriptor that is readable while ``do_work`` has something to read (valid between ``startup`` and
+        ``shutdown``); the link's thread waits on it."""
+
+    @abc.abstractmethod
     def do_work(self) -> None:
-        """Handle what arrived (emits ``signal_receive``); called by the link loop (10 Hz warped)."""
+        """Handle what arrived (emits ``signal_receive``); called by the link when ``fileno()`` is readable."""
 
     @abc.abstractmethod
     def handle_initiate_transmission(self, msg: ModemTransmission) -> None:
@@ -101,7 +109,6 @@ class DatagramDriver(ModemDriver):
         self.received = 0  # datagrams received from others
         self.malformed = 0  # datagrams that are not a ModemTransmission
         self.refused: Counter[str] = Counter()  # datagrams dropped at the edge, by cause (malformed included)
-        self.refusals = RateLimitedLog(log, REFUSED_LOG_PERIOD_S)
 
     # -------------------------------------------------------------------------------------- transport
     @abc.abstractmethod

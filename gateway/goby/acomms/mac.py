@@ -1,8 +1,10 @@
 """Goby3's TDMA MAC (``goby::acomms::MACManager``, MAC_FIXED_DECENTRALIZED): slots by src / seconds, on warped time.
 
 Pure logic: ``do_work(now)`` takes warped seconds since the epoch and calls ``on_initiate(slot)`` at the start of
-each of our slots. Every node with the same slot list and the same warped clock computes the same boundaries from
-the reference (UTC midnight of the warped day, or ``fixed_ref_time``): no messages are exchanged.
+each of our slots; ``next_slot_time(now)`` says when it next has something to do (the link's thread puts a timer
+there instead of calling ``do_work`` at Goby's 10 Hz). Every node with the same slot list and the same warped
+clock computes the same boundaries from the reference (UTC midnight of the warped day, or ``fixed_ref_time``): no
+messages are exchanged.
 """
 
 from __future__ import annotations
@@ -74,8 +76,18 @@ class MacManager:
             index = (index + 1) % len(self.cfg.slot)
         self.next_slot_t, self._index = t, index
 
+    def next_slot_time(self, now: float) -> float | None:
+        """When ``do_work`` next starts a slot (warped s since the epoch; it must be called once that time has
+        passed), computing the schedule from ``now`` if it has none yet; None when it never will (MAC_NONE, no
+        slots)."""
+        if self.cfg.type == MAC_NONE or not self.cfg.slot:
+            return None
+        if self.next_slot_t is None:
+            self._restart(now)
+        return self.next_slot_t
+
     def do_work(self, now: float) -> None:
-        """Start the slot whose time has come (call often: Goby calls it at 10 Hz warped)."""
+        """Start the slot whose time has come (call it once ``next_slot_time`` has passed)."""
         if self.cfg.type == MAC_NONE:
             return
         if not self.cfg.slot:

@@ -154,7 +154,9 @@ class UDPMulticastDriver(DatagramDriver):
             self._sock = None
 
     def fileno(self) -> int:
-        return -1 if self._sock is None else self._sock.fileno()
+        if self._sock is None:
+            raise ValueError(f"{self.name or 'udp_multicast'}: not started")
+        return self._sock.fileno()
 
     def _max_frame_size(self, msg: ModemTransmission) -> int:
         for pair in self._mc.rate_to_bytes:

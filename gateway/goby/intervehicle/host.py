@@ -13,7 +13,7 @@ from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConf
 
 
 class HostedIntervehicle:
-    """The portal and the process context its link threads share; ``close()`` stops both (idempotent)."""
+    """The portal and the process context of its ``intervehicle`` thread; ``close()`` stops both (idempotent)."""
 
     def __init__(self, portal: IntervehiclePortal, context: ProcessContext) -> None:
         self.portal = portal

@@ -1,8 +1,11 @@
 """One intervehicle link (Goby3's ``ModemDriverThread`` logic, ``intervehicle/driver_thread.cpp``), free of sockets.
 
 It owns the link's DynamicBuffer, its TDMA MAC and its modem driver, and talks to the rest of the vehicle through
-:class:`LinkOutputs` callbacks (the portal thread publishes them on interprocess). Every method runs on the one
-thread that calls ``loop`` (the link's thread).
+:class:`LinkOutputs` callbacks (the broker's intervehicle thread publishes them on interprocess). Every method runs
+on one thread (in the broker, its intervehicle thread). Goby runs the link in a 10 Hz loop; here the work is split
+so that a thread waits for it instead: ``receive()`` when the driver's ``fileno()`` is readable, ``run_due()`` at
+``next_deadline()`` (the next slot start or ttl expiry), ``flush_logs()`` once held-back log lines are due.
+``loop()`` does all of it, for a link driven by hand (tests, benchmarks).
 
 - ``buffer_message(stm)``: a local publication; buffered for every remote subscriber of its (group, DCCL id) in this
   subnet, else expired at once with EXPIRED_NO_SUBSCRIBERS.
@@ -188,14 +191,42 @@ class Link:
             self.driver.shutdown()
 
     def loop(self) -> None:
-        """Expire, let the driver read, let the MAC start a slot (Goby's 10 Hz loop)."""
+        """Expire, let the driver read, let the MAC start a slot, flush due log lines (Goby's 10 Hz loop)."""
         now = self.now()
+        self._expire_due(now)
+        self.driver.do_work()
+        self.mac.do_work(now)
+        self.flush_logs()
+
+    def receive(self) -> None:
+        """Handle what the driver has (call when its ``fileno()`` is readable)."""
+        self.driver.do_work()
+
+    def run_due(self) -> None:
+        """The timed part of Goby's loop: expire values past their ttl, start the slot whose time has come."""
+        now = self.now()
+        self._expire_due(now)
+        self.mac.do_work(now)
+
+    def next_deadline(self) -> float | None:
+        """When ``run_due`` next has work (warped s since the epoch): the next slot start or ttl expiry."""
+        times = [t for t in (self.mac.next_slot_time(self.now()), self.buffer.next_expiry()) if t is not None]
+        return min(times, default=None)
+
+    @property
+    def held_log_lines(self) -> int:
+        """Log lines held back so far (rate-limited drops and refusals); a rise means a ``flush_logs`` is due later."""
+        return self.drops.held_back + self.driver.refusals.held_back
+
+    def flush_logs(self) -> None:
+        """Write the summary lines of held-back drops and refusals whose quiet period is over."""
+        self.drops.flush()
+        self.driver.refusals.flush()
+
+    def _expire_due(self, now: float) -> None:
         for dest, _bid, value in self.buffer.expire(now):
             self.counters.expired_ttl += 1
             self._expire(value, dest, ExpireData.EXPIRED_TIME_TO_LIVE_EXCEEDED, now)
-        self.driver.do_work()
-        self.mac.do_work(now)
-        self.drops.flush()
 
     def _initiate(self, slot: ModemTransmission) -> None:
         self.counters.slot_starts.append(slot.time / 1e6)

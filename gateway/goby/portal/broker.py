@@ -1,9 +1,12 @@
 """The broker (gobyd's router and manager): an XPUB/XSUB proxy plus the manager that hands out endpoints and
 runs the start-up hold.
 
-Two threads: the proxy (``zmq.proxy_steerable``, stopped through an inproc control socket) and the manager
-(REP for endpoint requests, SUB/PUB on the proxy for hold-state requests, and the admission control of
-``broker_admission``: ZAP answers and connection counts).  Neither thread runs user code.
+Two threads: the proxy (``zmq.proxy_steerable``, in C, stopped through an inproc control socket) and the manager,
+a ``util.reactor.Reactor`` whose readers are the REP for endpoint requests, the SUB on the proxy for hold-state
+requests (answered on a PUB) and the sockets of ``broker_admission`` (ZAP answers, connection counts).  The manager
+has no timed work (ZeroMQ sends the heartbeats; admission windows are computed when a handshake asks), so an idle
+broker's threads all sleep.  Neither thread runs user code; ``intervehicle {}`` links run on a third
+(``gateway.goby.intervehicle.portal``).
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ from gateway.goby.protobuf.interprocess_zeromq_pb2 import (
     ManagerResponse,
     Socket,
 )
+from util.reactor import Reactor
 
 log = logging.getLogger(__name__)
 
@@ -93,7 +97,7 @@ class Broker:
         self._mctx: zmq.Context | None = None
         self._threads: list[threading.Thread] = []
         self._proxy_control: zmq.Socket | None = None
-        self._manager_stop: zmq.Socket | None = None
+        self._manager: Reactor | None = None  # the manager thread's loop (stop() stops it)
         self._started = False
         self._stopped = False
         self._ipc_files: list[str] = []  # created by this broker, removed on stop
@@ -153,8 +157,7 @@ class Broker:
             xsub.close()
             self.stop()
             raise BrokerError(f"cannot bind the broker's pub/sub sockets: {exc}") from exc
-        self._proxy_control = self._start_thread(self._zctx, "broker-control", self._run_proxy, (xpub, xsub),
-                                                 "broker-proxy")
+        self._proxy_control = self._start_proxy(self._zctx, xpub, xsub)
 
         rep = self._mctx.socket(zmq.REP)
         rep.setsockopt(zmq.LINGER, 0)
@@ -174,8 +177,8 @@ class Broker:
             self.stop()
             raise BrokerError(f"cannot bind the manager socket {manager_endpoint(self.ipc)}: {exc}") from exc
         self._admission = None  # the manager thread owns and closes it from here on
-        self._manager_stop = self._start_thread(self._mctx, "broker-manager-stop", self._run_manager,
-                                                (rep, admission), "broker-manager")
+        self._manager = Reactor("broker-manager")
+        self._start_thread(self._run_manager, (rep, admission, self._manager), "broker-manager")
         if not self._ready.wait(10):
             self.stop()
             raise BrokerError("the broker's manager thread did not become ready within 10 s")
@@ -184,19 +187,20 @@ class Broker:
             self._start_intervehicle()
         return self
 
-    def _start_thread(self, zctx: zmq.Context, channel: str, target: Any, args: tuple[Any, ...],
-                      name: str) -> zmq.Socket:
-        """Start ``target(*args, peer)`` on a thread of its own, ``peer`` one end of an inproc PAIR channel; returns
-        the other end, through which this object tells the thread to stop."""
-        addr = f"inproc://{channel}-{id(self)}"
+    def _start_proxy(self, zctx: zmq.Context, xpub: zmq.Socket, xsub: zmq.Socket) -> zmq.Socket:
+        """Start the proxy on a thread of its own; returns its control socket (an inproc PAIR: ``TERMINATE``)."""
+        addr = f"inproc://broker-control-{id(self)}"
         peer = zctx.socket(zmq.PAIR)
         peer.bind(addr)
         control = zctx.socket(zmq.PAIR)
         control.connect(addr)
-        thread = threading.Thread(target=target, args=(*args, peer), name=name)
+        self._start_thread(self._run_proxy, (xpub, xsub, peer), "broker-proxy")
+        return control
+
+    def _start_thread(self, target: Any, args: tuple[Any, ...], name: str) -> None:
+        thread = threading.Thread(target=target, args=args, name=name)
         thread.start()
         self._threads.append(thread)
-        return control
 
     def _start_intervehicle(self) -> None:
         """Run the intervehicle links in this process, as gobyd does (raises ``BrokerError`` naming the link)."""
@@ -221,13 +225,12 @@ class Broker:
             self._intervehicle.close()
         if self._proxy_control is not None:
             self._proxy_control.send(b"TERMINATE")
-        if self._manager_stop is not None:
-            self._manager_stop.send(b"STOP")
+        if self._manager is not None:
+            self._manager.stop()
         for thread in self._threads:
             thread.join(10)
-        for sock in (self._proxy_control, self._manager_stop):
-            if sock is not None:
-                sock.close(linger=0)
+        if self._proxy_control is not None:
+            self._proxy_control.close(linger=0)
         if self._admission is not None:  # start() failed before the manager thread took it over
             self._admission.close()
         for zctx in (self._zctx, self._mctx):
@@ -258,7 +261,8 @@ class Broker:
             for sock in (xpub, xsub, control):
                 sock.close(linger=0)
 
-    def _run_manager(self, rep: zmq.Socket, admission: AdmissionControl, stop: zmq.Socket) -> None:
+    def _run_manager(self, rep: zmq.Socket, admission: AdmissionControl, reactor: Reactor) -> None:
+        """The manager thread: every socket a reader of ``reactor``, until ``stop()`` stops it."""
         endpoints = self.endpoints()
         sub = self._mctx.socket(zmq.SUB)
         pub = self._mctx.socket(zmq.PUB)
@@ -271,29 +275,37 @@ class Broker:
             MANAGER_REQUEST_GROUP, Scheme.PROTOBUF, ManagerRequest.DESCRIPTOR.full_name).encode())
         response_ident = make_identifier(
             MANAGER_RESPONSE_GROUP, Scheme.PROTOBUF, ManagerResponse.DESCRIPTOR.full_name, os.getpid(), thread_id())
-        poller = zmq.Poller()
-        guards = admission.sockets()
-        for sock in (rep, sub, stop, *guards):
-            poller.register(sock, zmq.POLLIN)
+
+        def answer_requests() -> None:
+            while True:  # REP: each request is answered before the next is read
+                try:
+                    raw = rep.recv(zmq.NOBLOCK)
+                except zmq.Again:
+                    return
+                rep.send(self._answer_rep(raw))
+
+        def answer_holds() -> None:
+            while True:
+                try:
+                    frame = sub.recv(zmq.NOBLOCK)
+                except zmq.Again:
+                    return
+                reply = self._answer_hold(frame)
+                if reply is not None:
+                    pub.send(encode_frame(response_ident, reply.SerializeToString()))
+
+        reactor.add_reader(rep, answer_requests)
+        reactor.add_reader(sub, answer_holds)
+        for sock in admission.sockets():
+            reactor.add_reader(sock, admission.reader(sock))
         self._ready.set()
         try:
-            while True:
-                ready = dict(poller.poll())
-                if stop in ready:
-                    return
-                if rep in ready:
-                    rep.send(self._answer_rep(rep.recv()))
-                if sub in ready:
-                    reply = self._answer_hold(sub.recv())
-                    if reply is not None:
-                        pub.send(encode_frame(response_ident, reply.SerializeToString()))
-                for sock in guards:
-                    if sock in ready:
-                        admission.handle(sock)
+            reactor.run(until=lambda: self._stopped)  # (a stop() just before run() began is not missed)
         except zmq.ContextTerminated:
             pass
         finally:
-            for sock in (rep, sub, pub, stop):
+            reactor.close()
+            for sock in (rep, sub, pub):
                 sock.close(linger=0)
             admission.close()
 

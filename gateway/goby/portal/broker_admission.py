@@ -12,7 +12,8 @@ Counting without knowing which connection a ZAP request belongs to (libzmq 4.3 r
 handshake (else ZeroMQ would have dropped it); a younger one counts only up to the number of peers approved in
 that window.  The estimate never undercounts, so the cap holds.
 
-Not thread safe: :class:`Admission` lives on the broker's manager thread, which polls the ZAP and monitor sockets.
+Not thread safe: :class:`Admission` lives on the broker's manager thread, whose reactor reads the ZAP and monitor
+sockets.
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import zmq
-from zmq.utils.monitor import parse_monitor_message
+
+from gateway.goby.portal.monitor_events import parse_monitor_frames
 
 log = logging.getLogger(__name__)
 
@@ -79,11 +81,13 @@ class Admission:
 
     def on_event(self, frames: list[bytes]) -> None:
         """One monitor event (ACCEPTED or DISCONNECTED, with the connection's descriptor)."""
-        event = parse_monitor_message(frames)
-        if event["event"] == zmq.EVENT_ACCEPTED:
-            self._accepted[int(event["value"])] = self._now()
-        elif event["event"] == zmq.EVENT_DISCONNECTED:
-            self._accepted.pop(int(event["value"]), None)
+        event = parse_monitor_frames(frames)
+        if event is None:
+            return
+        if event.event == zmq.EVENT_ACCEPTED:
+            self._accepted[event.value] = self._now()
+        elif event.event == zmq.EVENT_DISCONNECTED:
+            self._accepted.pop(event.value, None)
 
     def drain(self) -> None:
         """Read every pending monitor event, so a ZAP decision sees every accepted connection."""
@@ -114,8 +118,8 @@ class Admission:
 class AdmissionControl:
     """The ZAP handlers (one per ZeroMQ context) and one :class:`Admission` per listening socket.
 
-    ``guard`` runs on the thread that creates the sockets, before they bind; ``sockets``/``handle`` on the one
-    thread that polls them (the broker's manager thread), which also closes them with ``close``.
+    ``guard`` runs on the thread that creates the sockets, before they bind; ``sockets``/``handle``/``reader`` on
+    the one thread that polls them (the broker's manager thread), which also closes them with ``close``.
     """
 
     def __init__(self, limits: BrokerLimits) -> None:
@@ -145,16 +149,23 @@ class AdmissionControl:
         events = [a.events for a in self.admissions.values() if a.events is not None]
         return [*self._zaps.values(), *events]
 
+    def reader(self, sock: zmq.Socket) -> Callable[[], None]:
+        """The reactor handler of ``sock`` (one of :meth:`sockets`)."""
+        return lambda: self.handle(sock)
+
     def handle(self, sock: zmq.Socket) -> None:
-        """Read what ``sock`` (one of :meth:`sockets`) has: answer a ZAP request or count monitor events."""
+        """Read everything ``sock`` (one of :meth:`sockets`) has: answer ZAP requests or count monitor events."""
         if sock in self._zaps.values():
-            request = sock.recv_multipart()
-            _version, request_id, domain, address = (request + [b""] * 4)[:4]
-            admission = self.admissions.get(domain)
-            ok = admission is None or admission.admit(address.decode(errors="replace"))
-            status = [b"200", b"OK"] if ok else [b"400", b"too many connections"]
-            sock.send_multipart([b"1.0", request_id, *status, b"", b""])
-            return
+            while True:
+                try:
+                    request = sock.recv_multipart(zmq.NOBLOCK)
+                except zmq.Again:
+                    return
+                _version, request_id, domain, address = (request + [b""] * 4)[:4]
+                admission = self.admissions.get(domain)
+                ok = admission is None or admission.admit(address.decode(errors="replace"))
+                status = [b"200", b"OK"] if ok else [b"400", b"too many connections"]
+                sock.send_multipart([b"1.0", request_id, *status, b"", b""])
         for admission in self.admissions.values():
             if admission.events is sock:
                 admission.drain()
