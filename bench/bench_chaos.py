@@ -36,8 +36,10 @@ import sys
 import tempfile
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Generic, TypeVar
 
 from bench.stats import markdown_table
 from gateway.goby.portal.testing import PortalClient
@@ -165,7 +167,7 @@ class PortalProbe:
                          threading.Thread(target=self._guard, args=(self._publish,), name="chaos-portal-pub",
                                           daemon=True)]
 
-    def _guard(self, body) -> None:  # noqa: ANN001
+    def _guard(self, body: Callable[[], None]) -> None:
         try:
             body()
         except BaseException as exc:  # noqa: BLE001 - reported in the summary
@@ -222,10 +224,13 @@ class Kill:
     recovered_at: float | None = None
 
 
-class _MissionTarget:
+_Mission = TypeVar("_Mission", bound=UsvMission | TrailMission)
+
+
+class _MissionTarget(Generic[_Mission]):
     """What the soak needs of a mission: start it until every vehicle is under command, stop it."""
 
-    mission: UsvMission | TrailMission
+    mission: _Mission
     command_timeout_s: float = 180.0
 
     def start(self) -> None:
@@ -236,7 +241,7 @@ class _MissionTarget:
         self.mission.stop()
 
 
-class UsvTarget(_MissionTarget):
+class UsvTarget(_MissionTarget[UsvMission]):
     """The USV mission as one flat process group: the soak kills a process and restarts it itself."""
 
     def __init__(self, args: argparse.Namespace, out: Path, socket_dir: Path) -> None:
@@ -248,7 +253,8 @@ class UsvTarget(_MissionTarget):
         self.probe_ipc_base = self.settings.ipc_base
 
     def poll(self) -> None:
-        self.mission.moos.poll()  # type: ignore[union-attr]
+        assert self.mission.moos is not None  # start() made it
+        self.mission.moos.poll()
 
     def _group(self) -> ProcessGroup:
         assert self.mission.group is not None
@@ -274,7 +280,7 @@ class UsvTarget(_MissionTarget):
         return time.monotonic() - process.started_at >= 1.0
 
 
-class TrailTarget(_MissionTarget):
+class TrailTarget(_MissionTarget[TrailMission]):
     """The trail mission as all.launch runs it; every platform's goby-launch restarts what the soak kills."""
 
     command_timeout_s = 300.0
@@ -412,8 +418,7 @@ def report(kills: list[Kill], probes: tuple[MoosProbe, PortalProbe], rss_start: 
         cells.append(f"{start:.0f} → {end:.0f}" if start and end else "-")
         rows.append(cells)
     totals = []
-    for label, probe in zip(("MOOS", "interprocess"), probes, strict=True):
-        ledger = probe.ledger
+    for label, ledger in (("MOOS", probes[0].ledger), ("interprocess", probes[1].ledger)):
         with ledger.lock:
             sent, delivered = len(ledger.sent), len(ledger.delivered)
             refused, reported = len(ledger.refused), len(ledger.reported - ledger.delivered)

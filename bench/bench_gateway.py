@@ -78,7 +78,7 @@ class MoosReceiver:
         self.client.close(True)
 
 
-def _sample(n: int, send: Callable[[str], None], receive: Callable[[float], list[str]],
+def _sample(n: int, send: Callable[[str], object], receive: Callable[[float], list[str]],
             timeout: float = 5.0, jitter_s: float = 0.0) -> list[float]:
     """Send one message at a time and wait for it; latencies in ms (lost ones raise).
 
@@ -113,7 +113,7 @@ def _goby_strings(peer: PortalClient, box: list[str]) -> Callable[[float], list[
     return receive
 
 
-def _throughput(burst: int, send: Callable[[str], None], receive: Callable[[float], list[str]],
+def _throughput(burst: int, send: Callable[[str], object], receive: Callable[[float], list[str]],
                 window: int = 200) -> tuple[float, int]:
     """Send ``burst`` messages keeping at most ``window`` in flight (below ZeroMQ's and MOOS's queue limits, so a
     slow stage shows up as a lower rate, not as drops); returns (messages/s, number received)."""

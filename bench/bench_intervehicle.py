@@ -10,6 +10,7 @@ for both links, per simulated hour, and as a share of one core at the course's w
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 from gateway.goby.acomms.ether import Ether, EtherDriver
 from gateway.goby.acomms.protobuf.amac_config_pb2 import MAC_FIXED_DECENTRALIZED
@@ -29,7 +30,7 @@ CYCLES = 200
 WARP = 5
 
 
-def link(modem_id: int, ether: Ether, clock) -> Link:
+def link(modem_id: int, ether: Ether, clock: Callable[[], float]) -> Link:
     cfg = LinkConfig(modem_id=modem_id, subnet_mask=0xFF00)
     cfg.driver.driver_name = "ether"
     cfg.mac.type = MAC_FIXED_DECENTRALIZED

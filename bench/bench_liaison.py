@@ -19,13 +19,17 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from bench.stats import median_p99
-from gateway.goby.portal.testing import PortalClient, broker_process
+from gateway.goby.portal.testing import BrokerProcess, PortalClient, broker_process
 from launch.liaison.portal_side import READY_PREFIX
 from launch.liaison.testing import PROFILE_PREFIX as PROFILE_MARKER
 from launch.liaison.testing import browser_skip_reason, chromium
 from util.process import ChildProcess, ProcessError, free_port
+
+if TYPE_CHECKING:  # selenium is a test extra; chromium() imports it when a browser runs
+    from selenium.webdriver.remote.webdriver import WebDriver
 
 RECORDER = """
 window._drawn = [];
@@ -66,7 +70,7 @@ def chromium_pids(profile_marker: str) -> list[int]:
     return pids
 
 
-def start_liaison(broker, update_freq: float, log: Path) -> tuple[ChildProcess, str]:
+def start_liaison(broker: BrokerProcess, update_freq: float, log: Path) -> tuple[ChildProcess, str]:
     port = free_port()
     cfg = (f'interprocess {{ {broker.interprocess_text()} }} http_address: "127.0.0.1" http_port: {port} '
            f"update_freq: {update_freq}")
@@ -80,7 +84,7 @@ def start_liaison(broker, update_freq: float, log: Path) -> tuple[ChildProcess, 
     return proc, f"http://127.0.0.1:{port}"
 
 
-def run_latency(driver, client: PortalClient, url: str, seconds: float, period_s: float = 0.02,
+def run_latency(driver: WebDriver, client: PortalClient, url: str, seconds: float, period_s: float = 0.02,
                 jitter: bool = False) -> list[float]:
     """Latencies (ms) of the values the page drew, publishing one value every ``period_s`` (random phase with
     ``jitter``, so a value waits a random part of the update period)."""
@@ -108,7 +112,7 @@ def run_latency(driver, client: PortalClient, url: str, seconds: float, period_s
     return [(at / 1000.0 - sent[value]) * 1000.0 for value, at in drawn if value in sent]
 
 
-def run_load(driver, client: PortalClient, url: str, liaison_pid: int, seconds: float,
+def run_load(driver: WebDriver, client: PortalClient, url: str, liaison_pid: int, seconds: float,
              groups: int = 100, hz: float = 50.0) -> tuple[float, float, int]:
     driver.get(f"{url}/?_=/scope")
     time.sleep(1.0)

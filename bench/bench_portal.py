@@ -139,7 +139,12 @@ def call_soon_latency(n: int) -> tuple[float, float]:
         for _ in range(n):
             done.clear()
             start = time.perf_counter()
-            worker.call_soon(lambda start=start: (samples.append(time.perf_counter() - start), done.set()))
+
+            def arrived(start: float = start) -> None:
+                samples.append(time.perf_counter() - start)
+                done.set()
+
+            worker.call_soon(arrived)
             done.wait(5)
             time.sleep(0.0005)  # let the worker block in its poll again
     samples.sort()

@@ -26,6 +26,7 @@ from frontseat.protobuf import basic_simulator_tuning_pb2 as tuning_pb
 from frontseat.protobuf import frontseat_config_pb2 as config_pb
 from frontseat.protobuf import frontseat_pb2 as fs_pb
 from frontseat.simulator import protocol
+from util.descriptors import initialization_errors
 from util.reactor import Reactor
 
 log = logging.getLogger(__name__)
@@ -34,7 +35,10 @@ CONFIG_EXTENSION = sim_pb.basic_simulator_config
 EXTENSION_NAME = "goby.middleware.frontseat.protobuf.basic_simulator_config"
 TUNING_EXTENSION = tuning_pb.basic_simulator_tuning
 
-_CTRL_STATES = {"PAYLOAD": fs_pb.FRONTSEAT_ACCEPTING_COMMANDS, "AUV": fs_pb.FRONTSEAT_IN_CONTROL}
+_CTRL_STATES: dict[str, fs_pb.FrontSeatState.ValueType] = {
+    "PAYLOAD": fs_pb.FRONTSEAT_ACCEPTING_COMMANDS,
+    "AUV": fs_pb.FRONTSEAT_IN_CONTROL,
+}
 
 
 def frontseat_driver_load(cfg: config_pb.Config) -> FrontSeatDriver:
@@ -51,12 +55,12 @@ class BasicSimulatorDriver(FrontSeatDriver):
             raise DriverConfigError(f"frontseat_cfg has no [{EXTENSION_NAME}] block; the basic simulator driver needs one")
         self.sim_cfg = sim_pb.BasicSimulatorFrontSeatConfig()
         self.sim_cfg.CopyFrom(cfg.Extensions[CONFIG_EXTENSION])
-        missing = self.sim_cfg.FindInitializationErrors()
+        missing = initialization_errors(self.sim_cfg)
         if missing:
             raise DriverConfigError(f"[{EXTENSION_NAME}] is missing required field(s): {', '.join(missing)}")
         self.tuning = tuning_pb.BasicSimulatorTuning()
         self.tuning.CopyFrom(cfg.Extensions[TUNING_EXTENSION])
-        self._fs_state = fs_pb.FRONTSEAT_NOT_CONNECTED
+        self._fs_state: fs_pb.FrontSeatState.ValueType = fs_pb.FRONTSEAT_NOT_CONNECTED
         self._providing_data = False
         self._last_data_time = -math.inf
         self._last_request = fs_pb.CommandRequest()
@@ -76,7 +80,7 @@ class BasicSimulatorDriver(FrontSeatDriver):
         self._link.close()
 
     # ----- the six driver methods -------------------------------------------------------------------------
-    def frontseat_state(self) -> int:
+    def frontseat_state(self) -> fs_pb.FrontSeatState.ValueType:
         return self._fs_state
 
     def frontseat_providing_data(self) -> bool:

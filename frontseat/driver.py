@@ -89,15 +89,15 @@ class FrontSeatDriver(abc.ABC):
         self.signal_data_from_frontseat: Signal[fs_pb.InterfaceData] = Signal("data_from_frontseat")
         self.signal_raw_from_frontseat: Signal[fs_pb.Raw] = Signal("raw_from_frontseat")
         self.signal_raw_to_frontseat: Signal[fs_pb.Raw] = Signal("raw_to_frontseat")
-        self.signal_state_change: Signal[int] = Signal("state_change")
+        self.signal_state_change: Signal[fs_pb.InterfaceState.ValueType] = Signal("state_change")
         self.signal_raw_from_frontseat.connect(lambda raw: _log_raw(raw_in_log, raw))
         self.signal_raw_to_frontseat.connect(lambda raw: _log_raw(raw_out_log, raw))
 
-        self._helm_state = fs_pb.HELM_NOT_RUNNING
-        self._state = fs_pb.INTERFACE_STANDBY
+        self._helm_state: fs_pb.HelmState.ValueType = fs_pb.HELM_NOT_RUNNING
+        self._state: fs_pb.InterfaceState.ValueType = fs_pb.INTERFACE_STANDBY
         self._start_time = self._clock.now()
-        self._last_helm_error = fs_pb.ERROR_HELM_NONE
-        self._last_frontseat_error = fs_pb.ERROR_FRONTSEAT_NONE
+        self._last_helm_error: fs_pb.HelmError.ValueType = fs_pb.ERROR_HELM_NONE
+        self._last_frontseat_error: fs_pb.FrontSeatError.ValueType = fs_pb.ERROR_FRONTSEAT_NONE
         # An unset origin reads as (0, 0), as proto2 defaults do in Goby.
         self._geodesy = _make_geodesy(self._cfg.origin.lat, self._cfg.origin.lon)
 
@@ -115,7 +115,7 @@ class FrontSeatDriver(abc.ABC):
         """Send raw bytes or a raw line to the frontseat."""
 
     @abc.abstractmethod
-    def frontseat_state(self) -> int:
+    def frontseat_state(self) -> fs_pb.FrontSeatState.ValueType:
         """The driver's view of the frontseat (a ``FrontSeatState`` value)."""
 
     @abc.abstractmethod
@@ -155,22 +155,22 @@ class FrontSeatDriver(abc.ABC):
         """The driver's configuration (a copy owned by the driver; treat as read-only)."""
         return self._cfg
 
-    def state(self) -> int:
+    def state(self) -> fs_pb.InterfaceState.ValueType:
         """The interface state (an ``InterfaceState`` value)."""
         return self._state
 
-    def helm_state(self) -> int:
+    def helm_state(self) -> fs_pb.HelmState.ValueType:
         """The last helm state reported with :meth:`set_helm_state` (``HELM_NOT_RUNNING`` until then)."""
         return self._helm_state
 
-    def set_helm_state(self, helm_state: int) -> None:
+    def set_helm_state(self, helm_state: fs_pb.HelmState.ValueType) -> None:
         """Record the helm's state; it is kept until the next report (there is no helm timeout)."""
         self._helm_state = helm_state
 
-    def last_helm_error(self) -> int:
+    def last_helm_error(self) -> fs_pb.HelmError.ValueType:
         return self._last_helm_error
 
-    def last_frontseat_error(self) -> int:
+    def last_frontseat_error(self) -> fs_pb.FrontSeatError.ValueType:
         return self._last_frontseat_error
 
     def now(self) -> float:

@@ -16,7 +16,7 @@ class FrontSeatException(Exception):
 class HelmErrorException(FrontSeatException):
     """The helm is in error; carries a ``HelmError`` enum value."""
 
-    def __init__(self, helm_error: int) -> None:
+    def __init__(self, helm_error: fs_pb.HelmError.ValueType) -> None:
         self.helm_error = helm_error
         super().__init__(fs_pb.HelmError.Name(helm_error))
 
@@ -24,7 +24,7 @@ class HelmErrorException(FrontSeatException):
 class FrontSeatErrorException(FrontSeatException):
     """The frontseat is in error; carries a ``FrontSeatError`` enum value."""
 
-    def __init__(self, frontseat_error: int) -> None:
+    def __init__(self, frontseat_error: fs_pb.FrontSeatError.ValueType) -> None:
         self.frontseat_error = frontseat_error
         super().__init__(fs_pb.FrontSeatError.Name(frontseat_error))
 

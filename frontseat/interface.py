@@ -29,6 +29,7 @@ from frontseat.protobuf import moos_helm_frontseat_interface_config_pb2 as helm_
 from frontseat.protobuf import navigation_pb2 as nav_pb
 from gateway.goby.portal import MultiThreadApplication, use_context
 from gateway.moos_gateway.protobuf import moos_gateway_config_pb2 as gateway_pb
+from util.descriptors import message_type_of
 
 log = logging.getLogger(__name__)
 
@@ -226,8 +227,8 @@ def example_config(driver_module: object | None = None) -> str:
     from gateway.goby.portal.config import example_config as message_example
 
     fields = app_pb.FrontSeatInterfaceConfig.DESCRIPTOR.fields_by_name
-    app_body = message_example(fields["app"].message_type, 1)
-    interprocess_body = message_example(fields["interprocess"].message_type, 1)
+    app_body = message_example(message_type_of(fields["app"]), 1)
+    interprocess_body = message_example(message_type_of(fields["interprocess"]), 1)
     frontseat_body = message_example(config_pb.Config.DESCRIPTOR, 1)
     extension = getattr(driver_module, "CONFIG_EXTENSION", None)
     if extension is not None:

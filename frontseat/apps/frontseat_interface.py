@@ -8,6 +8,7 @@ import os
 import sys
 import textwrap
 from functools import partial
+from types import ModuleType
 
 from frontseat.errors import FrontSeatException
 from frontseat.interface import FrontSeatInterface, example_config
@@ -46,6 +47,7 @@ def _print_help(argv: list[str]) -> int:
 
 def _print_example(spec: str | None) -> int:
     """``--example_config``: with the extension of the driver ``spec`` names, or of the basic simulator if none."""
+    module: ModuleType | None
     if spec:
         print(f"Loading frontseat driver library: {spec}", file=sys.stderr)
         try:
