@@ -52,12 +52,16 @@ class Trials:
         self.order.append(n)
         self.ledger.deliver(n)
 
-    def warm_up(self, send: Callable[[], object], idle: Callable[[float], object]) -> None:
-        """Send -1 until one arrives, so the stream starts with the subscription in place."""
+    def warm_up(self, send: Callable[[], object], idle: Callable[[float], object]) -> bool:
+        """Send -1 until one arrives, so the stream starts with the subscription in place; False (a failure
+        recorded) if none arrived within 30 s."""
         deadline = time.monotonic() + 30
         while not self.warm.is_set() and time.monotonic() < deadline:
             send()
             idle(0.05)
+        if not self.warm.is_set():
+            self.failures.append("the warm-up message never arrived within 30 s: no trial run")
+        return self.warm.is_set()
 
     def record(self, n: int, accepted: bool) -> None:
         with self.ledger.lock:
@@ -69,8 +73,8 @@ class Trials:
         with self.ledger.lock:
             self.ledger.reported.update(n for n in numbers if n >= 0)
 
-    def run(self, send: Callable[[int], bool], kill: Callable[[], None], start: Callable[[], None],
-            idle: Callable[[float], None], period_s: float) -> None:
+    def run(self, send: Callable[[int], bool], kill: Callable[[], object], start: Callable[[], object],
+            idle: Callable[[float], object], period_s: float) -> None:
         """Stream ``send(n)`` every ``period_s`` through every trial's kill and restart (``idle`` waits)."""
         n = 0
 
@@ -127,8 +131,12 @@ def run_moos(trials: Trials, period_s: float, workdir: Path) -> None:
             first_connect[0] = False
 
         reader.set_on_connect_callback(on_connect)
-        reader.set_on_mail_callback(lambda: [trials.delivered(int(m.double())) for m in reader.fetch()
-                                             if m.key() == "SEQ"])
+        def on_mail() -> None:
+            for m in reader.fetch():
+                if m.key() == "SEQ":
+                    trials.delivered(int(m.double()))
+
+        reader.set_on_mail_callback(on_mail)
         reader.register("SEQ", 0)
         writer = comms()
         writer.set_on_undelivered_callback(lambda msgs: trials.reported([int(m.double()) for m in msgs
@@ -136,8 +144,11 @@ def run_moos(trials: Trials, period_s: float, workdir: Path) -> None:
         reader.run("127.0.0.1", db.port, "bench_reader")
         writer.run("127.0.0.1", db.port, "bench_writer")
         try:
-            reader.wait_until_connected(20_000) and writer.wait_until_connected(20_000)
-            trials.warm_up(lambda: writer.notify("SEQ", -1.0), time.sleep)
+            if not (reader.wait_until_connected(20_000) and writer.wait_until_connected(20_000)):
+                trials.failures.append("the reader or the writer did not connect to moos-db within 20 s")
+                return
+            if not trials.warm_up(lambda: writer.notify("SEQ", -1.0), time.sleep):
+                return
             trials.run(lambda n: writer.notify("SEQ", float(n)), db.kill, db.start, time.sleep, period_s)
         finally:
             writer.close()
@@ -171,7 +182,8 @@ def run_portal(trials: Trials, period_s: float, workdir: Path, tcp: bool) -> Non
                 writer.portal.on_undelivered = lambda lost: trials.reported(
                     [int(p.rstrip(b"\0")) for g, p in lost if g == "seq"])
                 writer.wait_ready()
-                trials.warm_up(lambda: writer.publish("seq", "-1"), writer.poll)
+                if not trials.warm_up(lambda: writer.publish("seq", "-1"), writer.poll):
+                    return
 
                 def start() -> None:
                     broker.start()
