@@ -49,8 +49,8 @@ def run(helm: Helm, vehicle: Vehicle, seconds: float, pokes: dict[str, str] | No
     """Simulate; returns the mean wall-clock cost of one helm iteration in microseconds."""
     t, desired, cost, n = 0.0, {"DESIRED_HEADING": 0.0, "DESIRED_SPEED": 0.0}, 0.0, 0
     helm.startup(t)
-    for var, value in (pokes or {}).items():
-        helm.handle_mail(var, value, t, "bench", t)
+    for var, poke in (pokes or {}).items():
+        helm.handle_mail(var, poke, t, "bench", t)
     while t < seconds:
         for var, value in (("NAV_X", vehicle.x), ("NAV_Y", vehicle.y), ("NAV_HEADING", vehicle.heading),
                            ("NAV_SPEED", vehicle.speed)):

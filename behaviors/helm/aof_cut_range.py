@@ -37,7 +37,7 @@ def cut_range_table(domain: IvPDomain, osx: float, osy: float, cnx: float, cny: 
     roc_scale = 100.0 / roc_span if roc_span > 0 else 0.0
     rows = []
     for sin_c, cos_c in courses:
-        row = []
+        row: list[float] = []
         append = row.append
         for v in speeds:
             wx, wy = v * sin_c - vcx, v * cos_c - vcy  # ownship velocity relative to the point

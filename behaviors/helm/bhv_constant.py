@@ -6,6 +6,8 @@ runnable iteration.
 
 from __future__ import annotations
 
+from typing import Any
+
 from .behavior import Behavior, parse_float
 from .ivp import ObjectiveFunction, zaic_peak
 
@@ -18,7 +20,7 @@ class _ConstantBehavior(Behavior):
     WRAP = False
     PEAK, BASE, SUMMIT_DELTA = 0.0, 0.0, 0.0
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.desired = 0.0
         self.peakwidth, self.basewidth, self.summitdelta = self.PEAK, self.BASE, self.SUMMIT_DELTA
@@ -62,7 +64,7 @@ class ConstantHeadingBehavior(_ConstantBehavior):
     PEAK, BASE, SUMMIT_DELTA = 10.0, 170.0, 25.0
     WRAP = True
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.complete_thresh = -1.0
 

@@ -9,6 +9,7 @@ the helm's time with :class:`behaviors.helm.contacts.LinearExtrapolator`.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from .behavior import Behavior, parse_bool, parse_float
 from .contacts import LinearExtrapolator
@@ -21,7 +22,7 @@ _NOT_SUPPORTED = ("complete_after_retired", "match_contact_group", "ignore_conta
 class ContactBehavior(Behavior):
     """Ownship (``osx, osy, osh, osv``) and contact (``cnx, cny, cnh, cnv, cnutc``) state, updated each iteration."""
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.contact = ""
         self.extrapolate = True

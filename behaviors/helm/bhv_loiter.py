@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from .behavior import Behavior, parse_bool, parse_float
 from .cruise_speed import CruiseSpeed
@@ -18,7 +19,7 @@ class LoiterBehavior(CruiseSpeed, Behavior):
     DEFAULT_NAME = "bhv_loiter"
     DOMAIN_VARS = ("course", "speed")
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.polygon: Polygon | None = None
         self.polygon_spec = ""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from .behavior import Behavior, parse_bool, parse_float
 from .errors import ParamError
@@ -16,7 +17,7 @@ class StationKeepBehavior(Behavior):
     DEFAULT_NAME = "bhv_stationkeep"
     DOMAIN_VARS = ("course", "speed")
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.station: Point | None = None
         self.center_activate = False

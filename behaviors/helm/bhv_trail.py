@@ -16,6 +16,7 @@ its last report is older than the decay end.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from .aof_cut_range import cut_range_table
 from .behavior import parse_bool, parse_float
@@ -41,7 +42,7 @@ class TrailBehavior(ContactBehavior):
     DEFAULT_NAME = "(d)trail"
     DOMAIN_VARS = ("course", "speed")
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.trail_range = 50.0
         self.trail_angle = 180.0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from .behavior import Behavior, parse_bool, parse_float
 from .cruise_speed import CruiseSpeed
@@ -19,7 +20,7 @@ class WaypointBehavior(CruiseSpeed, Behavior):
     DEFAULT_NAME = "bhv_waypoint"
     DOMAIN_VARS = ("course", "speed")
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.engine = WaypointEngine()
         self.engine.capture_radius = 3.0

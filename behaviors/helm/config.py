@@ -10,11 +10,15 @@ import logging
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .behavior import parse_bool
 from .errors import BehaviorFileError, ParamError
 from .ivp import IvPDomain
 from .logic import is_number
+
+if TYPE_CHECKING:
+    from gateway.moos.mission_file import MissionFile
 
 log = logging.getLogger(__name__)
 
@@ -117,7 +121,7 @@ def _resolve(name: str, base_dir: Path | None) -> str:
     return str(candidate) if candidate.exists() else name
 
 
-def config_from_mission(mission, app_name: str) -> HelmConfig:
+def config_from_mission(mission: MissionFile, app_name: str) -> HelmConfig:
     """Read the helm block ``app_name`` and the globals of a :class:`gateway.moos.MissionFile`."""
     where = f"{mission.path}: ProcessConfig = {app_name}"
     if hasattr(mission, "has_process_config") and not mission.has_process_config(app_name):

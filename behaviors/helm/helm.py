@@ -175,13 +175,14 @@ class Helm:
         out.extend(Post(p.var, p.value) for p in result.postings)
         out.extend(self._behavior_lists(result.states))
         self.last_decisions = result.decisions
-        missing = [v.name for v in self.config.domain.vars.values() if v.name not in result.decisions and not v.optional]
+        undecided = [v.name for v in self.config.domain.vars.values()
+                     if v.name not in result.decisions and not v.optional]
         if result.halted:
             message = "BehaviorError"
         elif result.function_count == 0:
             message = "NothingToDo"
-        elif missing:
-            message = "MissingDecVars:" + ",".join(missing)
+        elif undecided:
+            message = "MissingDecVars:" + ",".join(undecided)
         else:
             message = "clear"
         out.append(Post("IVPHELM_SUMMARY", self._summary(result)))

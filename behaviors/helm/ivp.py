@@ -110,7 +110,7 @@ def zaic_peak(var: DomainVar, summit: float, peakwidth: float, basewidth: float,
     base_top = maxutil - sd
     base_slope = (base_top - minutil) / basewidth if basewidth > 0 else 0.0
     outer = peakwidth + basewidth
-    out = []
+    out: list[float] = []
     append = out.append
     for x in grid:
         d = abs(x - summit)

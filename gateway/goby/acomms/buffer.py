@@ -242,7 +242,7 @@ class DynamicBuffer:
 
     def expire(self, now: float) -> list[tuple[int, Hashable, Value]]:
         """Remove every value past its ttl; returns (dest, buffer_id, value) for each."""
-        out = []
+        out: list[tuple[int, Hashable, Value]] = []
         for d, subs in self._subs.items():
             for buffer_id, sub in subs.items():
                 out.extend((d, buffer_id, value) for value in sub.expire(now))

@@ -14,6 +14,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
+from typing import TypeVar, overload
 
 from google.protobuf.descriptor import Descriptor
 from google.protobuf.message import Message
@@ -33,6 +34,7 @@ from gateway.goby.dccl.registry import CodecRegistry, default_registry
 from util.descriptors import descriptor_of
 
 MessageType = type[Message] | Descriptor
+M = TypeVar("M", bound=Message)
 
 
 def _descriptor(message_type: MessageType | Message) -> Descriptor:
@@ -145,6 +147,12 @@ class Codec:
         return ids.decode_id(data)[0]
 
     # ----------------------------------------------------------------------------------------- decoding
+    @overload
+    def decode(self, data: bytes, message_type: type[M], *, now: float | None = None) -> M: ...
+
+    @overload
+    def decode(self, data: bytes, message_type: Descriptor | None = None, *, now: float | None = None) -> Message: ...
+
     def decode(self, data: bytes, message_type: MessageType | None = None, *, now: float | None = None) -> Message:
         """The one message in ``data``; trailing bytes are an error (``decode_prefix`` allows them).
 

@@ -46,15 +46,16 @@ PENDING_PURGE_US = 86_401_000_000
 
 
 def _numeric_group(group: GroupLike, error: type[IntervehicleError], has_group_function: bool,
-                   no_group_function: Callable[[Group], str]) -> Group:
-    """``group`` as a Group if intervehicle can carry it: it has a numeric id, and a group other than the broadcast
-    one comes with a group function (DCCL carries no group); else ``error`` naming what is missing."""
+                   no_group_function: Callable[[Group], str]) -> tuple[Group, int]:
+    """``group`` as a Group and its numeric id if intervehicle can carry it: it has a numeric id, and a group other
+    than the broadcast one comes with a group function (DCCL carries no group); else ``error`` naming what is
+    missing."""
     grp = as_group(group)
     if grp.numeric is None:
         raise error(f"intervehicle group {grp} needs a numeric id (e.g. \"{grp};1\")")
     if grp.numeric != BROADCAST_GROUP and not has_group_function:
         raise error(no_group_function(grp))
-    return grp
+    return grp, grp.numeric
 
 
 @dataclass(eq=False)
@@ -70,7 +71,7 @@ class _Pending:
 @dataclass(eq=False)
 class _Handler:
     group: Group
-    msg_type: type
+    msg_type: type[Message]
     callback: Callable[[Any], None]
     options: Subscriber
 
@@ -94,7 +95,7 @@ class InterVehicleForwarder:
         here (DCCL and PROTOBUF, as Goby does). Raises ``InvalidPublicationError`` for a group without a numeric
         id, or a non-broadcast group without ``publisher.set_group``."""
         publisher = publisher if publisher is not None else Publisher()
-        grp = _numeric_group(group, InvalidPublicationError, publisher.set_group is not None, lambda grp: (
+        grp, numeric = _numeric_group(group, InvalidPublicationError, publisher.set_group is not None, lambda grp: (
             f"publishing {msg.DESCRIPTOR.full_name} on intervehicle group {grp} (numeric {grp.numeric}) needs a "
             "Publisher with set_group: DCCL messages do not carry a group"))
         copy = type(msg)()
@@ -109,7 +110,7 @@ class InterVehicleForwarder:
             raise InvalidPublicationError(f"cannot DCCL-encode {msg.DESCRIPTOR.full_name} for {grp}: {exc}") from exc
         cfg = publisher.transporter_config()
         now_us = self._ctx.clock.now_micro()
-        stm = serialize_publication(data, copy, str(grp), grp.numeric, now_us, cfg)
+        stm = serialize_publication(data, copy, str(grp), numeric, now_us, cfg)
         self._record("publish", grp, copy.DESCRIPTOR.full_name)
         if cfg.intervehicle.buffer.ack_required:
             self._listen()
@@ -121,13 +122,13 @@ class InterVehicleForwarder:
             self._ip.publish(grp, copy, scheme=Scheme.PROTOBUF, record=False)
 
     # ----------------------------------------------------------------------------------------- subscribe
-    def subscribe(self, group: GroupLike, msg_type: type, callback: Callable[[Any], None],
+    def subscribe(self, group: GroupLike, msg_type: type[Message], callback: Callable[[Any], None],
                   subscriber: Subscriber | None = None) -> None:
         """Call ``callback(msg)`` on the owning thread for each ``msg_type`` received over a link whose derived group
         (``subscriber.group(msg)``, else the broadcast group) equals ``group``; the Subscription is sent to
         ``cfg.intervehicle.publisher_id``. A second subscribe to the same (type, group) replaces the first."""
         subscriber = subscriber if subscriber is not None else Subscriber()
-        grp = _numeric_group(group, InvalidSubscriptionError, subscriber.group is not None, lambda grp: (
+        grp, numeric = _numeric_group(group, InvalidSubscriptionError, subscriber.group is not None, lambda grp: (
             f"subscribing to {msg_type.DESCRIPTOR.full_name} on intervehicle group {grp} needs a Subscriber with "
             "a group function: DCCL messages do not carry a group"))
         cfg = subscriber.transporter_config()
@@ -142,7 +143,7 @@ class InterVehicleForwarder:
         self._handlers.setdefault(dccl_id, {})[str(grp)] = _Handler(grp, msg_type, callback, subscriber)
         self._record("subscribe", grp, msg_type.DESCRIPTOR.full_name)
         sub = Subscription(api_version=groups.API_VERSION, action=Subscription.SUBSCRIBE, dccl_id=dccl_id,
-                           group=grp.numeric, time=self._ctx.clock.now_micro())
+                           group=numeric, time=self._ctx.clock.now_micro())
         sub.header.src = 0
         sub.header.dest.extend(cfg.intervehicle.publisher_id)
         sub.intervehicle.CopyFrom(cfg.intervehicle)

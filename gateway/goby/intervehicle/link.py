@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 
 from gateway.goby.acomms.buffer import BufferNoDataError, DynamicBuffer, Value
@@ -85,15 +85,15 @@ class Buffered:
 
 @dataclass
 class LinkOutputs:
-    """Where the link's results go (each defaults to nothing)."""
+    """Where the link's results go (each defaults to nothing; what a callback returns is ignored)."""
 
-    data_in: Callable[[DCCLForwardedData], None] = lambda _m: None
-    ack_in: Callable[[AckMessagePair], None] = lambda _m: None
-    expire_in: Callable[[ExpireMessagePair], None] = lambda _m: None
-    subscription_rx: Callable[[Subscription], None] = lambda _m: None
-    subscription_report: Callable[[SubscriptionReport], None] = lambda _m: None
-    transmitted: Callable[[ModemTransmission], None] = lambda _m: None  # a data transmission we sent
-    initiated: Callable[[ModemTransmission], None] = lambda _m: None  # the MAC started one of our slots
+    data_in: Callable[[DCCLForwardedData], object] = lambda _m: None
+    ack_in: Callable[[AckMessagePair], object] = lambda _m: None
+    expire_in: Callable[[ExpireMessagePair], object] = lambda _m: None
+    subscription_rx: Callable[[Subscription], object] = lambda _m: None
+    subscription_report: Callable[[SubscriptionReport], object] = lambda _m: None
+    transmitted: Callable[[ModemTransmission], object] = lambda _m: None  # a data transmission we sent
+    initiated: Callable[[ModemTransmission], object] = lambda _m: None  # the MAC started one of our slots
 
 
 @dataclass
@@ -135,7 +135,7 @@ class Link:
         self._subscriber_cfgs: dict[tuple[int, BufferId], list[TransporterConfig]] = {}
         self._subscriptions: dict[tuple[int, BufferId], Subscription] = {}
         self._forwarded: dict[tuple[int, int, bytes, tuple[int, ...]], int] = {}
-        self._pending_ack: dict[int, list[tuple[int, BufferId, Value]]] = {}
+        self._pending_ack: dict[int, list[tuple[int, Hashable, Value]]] = {}  # ids as the buffer keeps them
         self._slot_srcs = {slot.src for slot in cfg.mac.slot}
         self.drops = RateLimitedLog(log, DROP_LOG_PERIOD_S)
         peers = {self.within_subnet(src) for src in self._slot_srcs if self.in_subnet(src) and src != self.modem_id}

@@ -50,6 +50,7 @@ from gateway.goby.intervehicle.protobuf.serializer_transporter_pb2 import Serial
 from gateway.goby.portal.context import ProcessContext, start_on_thread
 from gateway.goby.portal.group import Group
 from gateway.goby.portal.thread import SimpleThread
+from util.descriptors import enum_type_of
 from util.reactor import Timer
 
 log = logging.getLogger(__name__)
@@ -84,8 +85,8 @@ def make_driver(cfg: DriverConfig, ethers: dict[str, Ether] | None = None) -> Mo
         return EtherDriver(ethers[name])
     if which == "driver_type" and cfg.driver_type == DRIVER_UDP_MULTICAST:
         return UDPMulticastDriver()
-    what = cfg.driver_name if which == "driver_name" else DriverConfig.DESCRIPTOR.fields_by_name[
-        "driver_type"].enum_type.values_by_number[cfg.driver_type].name
+    what = cfg.driver_name if which == "driver_name" else enum_type_of(DriverConfig.DESCRIPTOR.fields_by_name[
+        "driver_type"]).values_by_number[cfg.driver_type].name
     raise ModemConfigError(f"link driver {what} is not available (use DRIVER_UDP_MULTICAST or driver_name: \"ether\")")
 
 

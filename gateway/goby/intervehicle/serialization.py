@@ -10,20 +10,14 @@ from typing import Any
 from google.protobuf import descriptor_pb2, descriptor_pool
 from google.protobuf.descriptor import Descriptor, FileDescriptor
 from google.protobuf.message import Message
-
-try:
-    from google.protobuf.message_factory import GetMessageClass
-except ImportError:  # pragma: no cover - protobuf < 4.21
-    from google.protobuf import message_factory
-
-    def GetMessageClass(descriptor: Descriptor) -> type[Message]:  # noqa: N802
-        return message_factory.MessageFactory().GetPrototype(descriptor)
+from google.protobuf.message_factory import GetMessageClass
 
 from gateway.goby.intervehicle.protobuf.serializer_transporter_pb2 import (
     SerializerProtobufMetadata,
     SerializerTransporterMessage,
 )
 from gateway.goby.portal.marshalling import Scheme
+from util.descriptors import descriptor_of
 
 log = logging.getLogger(__name__)
 
@@ -50,7 +44,7 @@ _metadata_cache: dict[str, SerializerProtobufMetadata] = {}
 
 def metadata_for(msg_type: type[Message] | Descriptor) -> SerializerProtobufMetadata:
     """The type's name and its file with every dependency, dependencies first (cached per type)."""
-    descriptor = msg_type if isinstance(msg_type, Descriptor) else msg_type.DESCRIPTOR
+    descriptor = msg_type if isinstance(msg_type, Descriptor) else descriptor_of(msg_type)
     cached = _metadata_cache.get(descriptor.full_name)
     if cached is None:
         files: list[FileDescriptor] = []

@@ -43,6 +43,7 @@ from gateway.goby.protobuf.interprocess_zeromq_pb2 import (
     ManagerResponse,
     Socket,
 )
+from util.descriptors import initialization_errors
 from util.reactor import Reactor
 
 log = logging.getLogger(__name__)
@@ -178,7 +179,7 @@ class Broker:
             raise BrokerError(f"cannot bind the manager socket {manager_endpoint(self.ipc)}: {exc}") from exc
         self._admission = None  # the manager thread owns and closes it from here on
         self._manager = Reactor("broker-manager")
-        self._start_thread(self._run_manager, (rep, admission, self._manager), "broker-manager")
+        self._start_thread(self._run_manager, (self._mctx, rep, admission, self._manager), "broker-manager")
         if not self._ready.wait(10):
             self.stop()
             raise BrokerError("the broker's manager thread did not become ready within 10 s")
@@ -261,11 +262,12 @@ class Broker:
             for sock in (xpub, xsub, control):
                 sock.close(linger=0)
 
-    def _run_manager(self, rep: zmq.Socket, admission: AdmissionControl, reactor: Reactor) -> None:
+    def _run_manager(self, mctx: zmq.Context, rep: zmq.Socket, admission: AdmissionControl,
+                     reactor: Reactor) -> None:
         """The manager thread: every socket a reader of ``reactor``, until ``stop()`` stops it."""
         endpoints = self.endpoints()
-        sub = self._mctx.socket(zmq.SUB)
-        pub = self._mctx.socket(zmq.PUB)
+        sub = mctx.socket(zmq.SUB)
+        pub = mctx.socket(zmq.PUB)
         for sock in (sub, pub):
             sock.setsockopt(zmq.LINGER, 0)
             sock.setsockopt(zmq.IPV6, 1)  # the proxy may be bound on an IPv6 address
@@ -316,7 +318,7 @@ class Broker:
         try:
             request.ParseFromString(raw)
             if not request.IsInitialized():
-                raise ValueError("missing " + ", ".join(request.FindInitializationErrors()))
+                raise ValueError("missing " + ", ".join(initialization_errors(request)))
         except Exception as exc:  # noqa: BLE001 - any decode failure
             log.error("manager: malformed ManagerRequest (%d bytes): %s", len(raw), exc)
             return b""
@@ -328,7 +330,7 @@ class Broker:
             _, payload = decode_frame(frame)
             request = ManagerRequest.FromString(payload)
             if not request.IsInitialized():
-                raise ValueError("missing " + ", ".join(request.FindInitializationErrors()))
+                raise ValueError("missing " + ", ".join(initialization_errors(request)))
         except (IdentifierError, Exception) as exc:  # noqa: BLE001
             log.error("manager: malformed hold request: %s", exc)
             return None
@@ -354,7 +356,7 @@ class Broker:
         log.error("manager: unknown request %d from %s", request.request, request.client_name)
         return None
 
-    def _socket(self, socket_type: int) -> Socket:
+    def _socket(self, socket_type: Socket.SocketType.ValueType) -> Socket:
         sock = Socket(
             socket_type=socket_type, connect_or_bind=Socket.CONNECT,
             send_queue_size=self.ipc.send_queue_size, receive_queue_size=self.ipc.receive_queue_size,

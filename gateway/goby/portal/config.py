@@ -14,7 +14,7 @@ import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Generic, TypeVar
 
 from google.protobuf import descriptor as pb_descriptor
 from google.protobuf import message as pb_message
@@ -33,11 +33,14 @@ _FD = pb_descriptor.FieldDescriptor
 _TTY_VERBOSITY = {1: 0, 2: 0, 4: 1, 5: 2, 6: 3, 7: 3}
 
 
-@dataclass
-class LoadedConfig:
-    """The result of :func:`load_config`."""
+ConfigT = TypeVar("ConfigT", bound=pb_message.Message)
 
-    cfg: pb_message.Message
+
+@dataclass
+class LoadedConfig(Generic[ConfigT]):
+    """The result of :func:`load_config`: ``cfg`` is of the type asked for."""
+
+    cfg: ConfigT
     verbosity: int
     example_requested: bool
     debug_cfg: bool
@@ -158,9 +161,9 @@ def build_parser(config_type: type[pb_message.Message], prog: str | None = None)
 
 
 def load_config(
-    config_type: type[pb_message.Message], argv: list[str] | None = None, prog: str | None = None,
+    config_type: type[ConfigT], argv: list[str] | None = None, prog: str | None = None,
     environ: Mapping[str, str] | None = None,
-) -> LoadedConfig:
+) -> LoadedConfig[ConfigT]:
     """Parse ``argv`` into a ``config_type`` message; ``AppConfigError`` names the file/option that is wrong."""
     env: Mapping[str, str] = os.environ if environ is None else environ
     parser = build_parser(config_type, prog)
@@ -343,7 +346,7 @@ def debug_text(cfg: pb_message.Message) -> str:
     return text_format.MessageToString(cfg)
 
 
-def load_for_run(config_type: type[pb_message.Message], argv: list[str] | None, prog: str) -> LoadedConfig | int:
+def load_for_run(config_type: type[ConfigT], argv: list[str] | None, prog: str) -> LoadedConfig[ConfigT] | int:
     """The start-up every Goby-style program shares: parse, or handle ``--example_config``/``debug_cfg``.
 
     Returns the loaded configuration to run with, or the exit code to return at once: 0 after printing the
