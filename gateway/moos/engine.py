@@ -90,6 +90,16 @@ Callback = Callable[[], object]
 UndeliveredCallback = Callable[[list[MoosMessage]], object]
 
 
+def _try_send(sock: socket.socket, data: bytes | memoryview) -> tuple[int, str]:
+    """One non-blocking ``send``: the bytes the kernel took, and why the link failed ("" if it did not)."""
+    try:
+        return sock.send(data), ""
+    except (BlockingIOError, InterruptedError):
+        return 0, ""
+    except OSError as exc:
+        return 0, f"send failed: {exc}"
+
+
 class ClientEngine:
     """State and reactor work of one MOOS client; ``comms`` adds the pymoos-compatible API on top."""
 
@@ -671,14 +681,7 @@ class ClientEngine:
 
     def _send(self, sock: socket.socket, generation: int, data: bytes, count: int) -> bool:
         """Write one packet (the caller claimed ``_writing``); True when all of it went."""
-        failure = ""
-        try:
-            sent = sock.send(data)
-        except (BlockingIOError, InterruptedError):
-            sent = 0
-        except OSError as exc:
-            sent = 0
-            failure = f"send failed: {exc}"
+        sent, failure = _try_send(sock, data)
         on_io = self._on_io_thread()
         with self._lock:
             self._writing = False
@@ -725,14 +728,7 @@ class ClientEngine:
                 return
             self._writing = True
             generation = self._generation
-        failure = ""
-        try:
-            sent = sock.send(pending)
-        except (BlockingIOError, InterruptedError):
-            sent = 0
-        except OSError as exc:
-            sent = 0
-            failure = f"send failed: {exc}"
+        sent, failure = _try_send(sock, pending)
         with self._lock:
             self._writing = False
             self._bytes_sent += sent
