@@ -16,6 +16,11 @@ from util.reactor import Reactor, Timer
 log = logging.getLogger(__name__)
 
 
+def _end_the_poll() -> None:
+    """The service timer's callback: nothing, its firing only ends the poll (``ThreadTransports.poll`` then runs the
+    portal's timed work)."""
+
+
 class ThreadTransports:
     """Everything one thread waits on, in one ``Reactor``; all methods except ``mailbox.post`` belong to the owner."""
 
@@ -49,7 +54,7 @@ class ThreadTransports:
                 self._on_pollable(sock, True)
             portal.on_pollable = self._on_pollable
             self._interprocess = portal
-            self._service_timer = self.reactor.call_later(0.0, self._service)
+            self._service_timer = self.reactor.call_later(0.0, _end_the_poll)
         return self._interprocess
 
     def _on_pollable(self, sock: zmq.Socket, add: bool) -> None:
@@ -65,14 +70,9 @@ class ThreadTransports:
         if portal is not None:
             portal.handle(sock)
 
-    def _service(self) -> None:
-        portal = self._interprocess
-        if portal is not None:
-            portal.service(time.monotonic())
-            self._arm_service(portal)
-
     def _arm_service(self, portal: InterProcessPortal) -> None:
-        """Keep one timer at the portal's next deadline (hold requests, probes, re-queries, give-ups)."""
+        """Keep one timer at the portal's next deadline (hold requests, probes, re-queries, give-ups), so the poll
+        ends then; ``poll`` runs the portal's timed work after every wake-up, this one included."""
         deadline = portal.next_deadline()
         timer = self._service_timer
         if timer is None:
