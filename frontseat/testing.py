@@ -152,3 +152,22 @@ def basic_simulator_frontseat_cfg(
         "  }\n"
         "}\n"
     )
+
+
+def start_interface_with_moos_helm(workdir: Path, env: dict[str, str], sim_port: int, moosdb_port: int, *,
+                                   warp: float, helm_running_timeout: float, lat: float = 41.592344,
+                                   lon: float = -70.711260) -> ChildProcess:
+    """A frontseat-interface process on the basic simulator with its embedded MOOS helm translation (a
+    ``moos_helm`` block naming ``moosdb_port``), warped, with ``env`` (the broker's) and its log in ``workdir``."""
+    from gateway.goby.portal.testing import app_process
+
+    cfg = workdir / "frontseat.pb.cfg"
+    cfg.write_text(
+        f"app {{ geodesy {{ lat_origin: {lat} lon_origin: {lon} }}\n"
+        f"      simulation {{ time {{ use_sim_time: true warp_factor: {warp} }} }} }}\n"
+        + basic_simulator_frontseat_cfg(sim_port, status_period=1, helm_running_timeout=helm_running_timeout)
+        + f'[goby.moos.protobuf.moos_helm] {{ server: "127.0.0.1" port: {moosdb_port} }}\n'
+    )
+    env = {**env, "FRONTSEAT_DRIVER_LIBRARY": "basic_simulator"}
+    return app_process([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg), "-v"], env=env,
+                       log_path=workdir / "iface.log")

@@ -4,7 +4,6 @@ embedded MOOS helm interface talks to the main thread by interthread (as Goby's 
 
 from __future__ import annotations
 
-import sys
 import time
 from functools import partial
 from pathlib import Path
@@ -18,8 +17,8 @@ from frontseat.loading import driver_factory, load_driver_library
 from frontseat.protobuf import frontseat_data_pb2 as data_pb
 from frontseat.protobuf import frontseat_interface_config_pb2 as app_pb
 from frontseat.protobuf import frontseat_pb2 as fs
-from frontseat.testing import basic_simulator_frontseat_cfg, running_simulator
-from gateway.goby.portal.testing import PortalClient, app_process, broker_process, running_app
+from frontseat.testing import basic_simulator_frontseat_cfg, running_simulator, start_interface_with_moos_helm
+from gateway.goby.portal.testing import PortalClient, broker_process, running_app
 from gateway.moos.testing import connected_comms, running_moosdb
 
 LAT, LON = 41.592344, -70.711260
@@ -66,17 +65,8 @@ def test_the_embedded_helm_talks_to_the_interface_by_interthread(tmp_path: Path)
         running_simulator() as sim,
         running_moosdb(community="usv", warp=WARP) as db,
     ):
-        cfg = tmp_path / "frontseat.pb.cfg"
-        cfg.write_text(
-            f"app {{ geodesy {{ lat_origin: {LAT} lon_origin: {LON} }}\n"
-            f"      simulation {{ time {{ use_sim_time: true warp_factor: {WARP} }} }} }}\n"
-            + basic_simulator_frontseat_cfg(sim.port, status_period=1, helm_running_timeout=5)
-            + f'[goby.moos.protobuf.moos_helm] {{ server: "127.0.0.1" port: {db.port} }}\n'
-        )
-        env = broker.env()
-        env["FRONTSEAT_DRIVER_LIBRARY"] = "basic_simulator"
-        iface = app_process([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg), "-v"], env=env,
-                            log_path=tmp_path / "iface.log")
+        iface = start_interface_with_moos_helm(tmp_path, broker.env(), sim.port, db.port, warp=WARP,
+                                               helm_running_timeout=5, lat=LAT, lon=LON)
         try:
             with connected_comms(db.port, "pHelmIvP", register=["NAV_HEADING", "NAV_SPEED"]) as helm:
                 nav: dict[str, float] = {}

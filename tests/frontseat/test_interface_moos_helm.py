@@ -6,14 +6,13 @@ to it, and its setpoints must reach the simulator as CMD lines.
 
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 
 from frontseat import groups
 from frontseat.protobuf import frontseat_pb2 as fs
-from frontseat.testing import basic_simulator_frontseat_cfg, running_simulator
-from gateway.goby.portal.testing import PortalClient, app_process, broker_process
+from frontseat.testing import running_simulator, start_interface_with_moos_helm
+from gateway.goby.portal.testing import PortalClient, broker_process
 from gateway.moos.testing import connected_comms, running_moosdb
 
 WARP = 10
@@ -25,17 +24,8 @@ def test_moos_helm_drives_the_simulator_through_the_interface(tmp_path: Path) ->
         running_simulator() as sim,
         running_moosdb(community="usv", warp=WARP) as db,
     ):
-        cfg = tmp_path / "frontseat.pb.cfg"
-        cfg.write_text(
-            "app { geodesy { lat_origin: 41.592344 lon_origin: -70.711260 }\n"
-            f"      simulation {{ time {{ use_sim_time: true warp_factor: {WARP} }} }} }}\n"
-            + basic_simulator_frontseat_cfg(sim.port, status_period=1, helm_running_timeout=60)
-            + f'[goby.moos.protobuf.moos_helm] {{ server: "127.0.0.1" port: {db.port} }}\n'
-        )
-        env = broker.env()
-        env["FRONTSEAT_DRIVER_LIBRARY"] = "basic_simulator"
-        iface = app_process([sys.executable, "-m", "frontseat.apps.frontseat_interface", str(cfg), "-v"], env=env,
-                           log_path=tmp_path / "iface.log")
+        iface = start_interface_with_moos_helm(tmp_path, broker.env(), sim.port, db.port, warp=WARP,
+                                               helm_running_timeout=60)
         try:
             with (
                 PortalClient(broker.interprocess_config(), name="observer") as client,
