@@ -110,21 +110,14 @@ def zaic_peak(var: DomainVar, summit: float, peakwidth: float, basewidth: float,
     base_top = maxutil - sd
     base_slope = (base_top - minutil) / basewidth if basewidth > 0 else 0.0
     outer = peakwidth + basewidth
-    out: list[float] = []
-    append = out.append
-    for x in grid:
-        d = abs(x - summit)
-        if wrap:
-            d %= period
-            if period - d < d:
-                d = period - d
-        if d <= peakwidth:
-            append(maxutil - peak_slope * d)
-        elif d <= outer:
-            append(base_top - base_slope * (d - peakwidth))
-        else:
-            append(minutil)
-    if all(u == minutil for u in out):
+    # per grid point: the (circular) distance d to the summit, then the piece it falls in (comprehensions: the
+    # helm builds two or three of these every iteration, and a loop with append costs twice as much)
+    distances = [abs(x - summit) for x in grid]
+    if wrap:
+        distances = [e if (e := period - d) < d else d for d in (d % period for d in distances)]
+    out = [maxutil - peak_slope * d if d <= peakwidth else base_top - base_slope * (d - peakwidth) if d <= outer
+           else minutil for d in distances]
+    if out.count(minutil) == len(out):
         nearest = min(range(len(grid)), key=lambda j: abs(grid[j] - summit))
         out[nearest] = maxutil
     return out
@@ -135,7 +128,8 @@ def normalise(values: list[float], top: float) -> list[float]:
     lo, hi = min(values), max(values)
     if hi == lo:
         return [0.0] * len(values)
-    return [top * (v - lo) / (hi - lo) for v in values]
+    span = hi - lo
+    return [top * (v - lo) / span for v in values]
 
 
 @dataclass
@@ -187,7 +181,7 @@ def solve(domain: IvPDomain, functions: list[ObjectiveFunction]) -> dict[str, fl
             continue
         scores = _separable_scores(name, var, active)
         if scores is not None:
-            best = max(range(var.points), key=scores.__getitem__)  # the first maximum: lowest index
+            best = scores.index(max(scores))  # the first maximum: lowest index
             decisions[name] = var.low + best * var.delta
     for name1, name2 in pairs:
         var1, var2 = domain.vars[name1], domain.vars[name2]

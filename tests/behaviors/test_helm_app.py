@@ -70,7 +70,7 @@ def test_one_unpostable_value_is_logged_and_the_postings_after_it_still_go_out(t
     assert "posting BAD_POST=None failed" in (tmp_path / "helm.log").read_text()
 
 
-def test_a_dead_helm_thread_makes_ivp_helm_exit_non_zero(tmp_path: Path) -> None:
+def test_a_failed_start_up_stops_the_helm_and_ivp_helm_exits_non_zero(tmp_path: Path) -> None:
     with _faulty_helm(tmp_path, "startup", "-", trigger=False) as (obs, proc):
         try:
             code = proc.wait(30)
@@ -80,5 +80,5 @@ def test_a_dead_helm_thread_makes_ivp_helm_exit_non_zero(tmp_path: Path) -> None
         assert obs.wait(lambda: "stopped" in str(obs.last("BHV_ERROR")), timeout=5)
         assert obs.values("IVPHELM_STATE") == []
     log = (tmp_path / "helm.log").read_text()
-    assert "the helm thread has stopped" in log and "no helm is running" in log
+    assert "the helm has stopped: start-up failed" in log and "no helm is running" in log
     assert "ValueError: root cause of startup" in log
