@@ -110,13 +110,15 @@ def zaic_peak(var: DomainVar, summit: float, peakwidth: float, basewidth: float,
     base_top = maxutil - sd
     base_slope = (base_top - minutil) / basewidth if basewidth > 0 else 0.0
     outer = peakwidth + basewidth
-    # per grid point: the (circular) distance d to the summit, then the piece it falls in (comprehensions: the
-    # helm builds two or three of these every iteration, and a loop with append costs twice as much)
-    distances = [abs(x - summit) for x in grid]
+    # one pass over the grid: the (circular) distance d to the summit, then the piece it falls in (``for d in
+    # [expr]`` is a plain assignment inside a comprehension; the helm builds two or three of these per iteration)
     if wrap:
-        distances = [e if (e := period - d) < d else d for d in (d % period for d in distances)]
-    out = [maxutil - peak_slope * d if d <= peakwidth else base_top - base_slope * (d - peakwidth) if d <= outer
-           else minutil for d in distances]
+        out = [maxutil - peak_slope * d if d <= peakwidth else base_top - base_slope * (d - peakwidth) if d <= outer
+               else minutil
+               for x in grid for e in [abs(x - summit) % period] for d in [e if e <= period - e else period - e]]
+    else:
+        out = [maxutil - peak_slope * d if d <= peakwidth else base_top - base_slope * (d - peakwidth) if d <= outer
+               else minutil for x in grid for d in [abs(x - summit)]]
     if out.count(minutil) == len(out):
         nearest = min(range(len(grid)), key=lambda j: abs(grid[j] - summit))
         out[nearest] = maxutil
