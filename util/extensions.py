@@ -20,7 +20,6 @@ the imported module's top level on the calling thread; callers load before they 
 
 from __future__ import annotations
 
-import hashlib
 import importlib
 import importlib.util
 import re
@@ -182,6 +181,8 @@ def _import_file(point: ExtensionPoint, spec: str) -> ModuleType:
     if not path.is_file():
         raise point.error(spec, "no such file")
     resolved = path.resolve()
+    import hashlib  # here, not at the top: it loads OpenSSL (3.6 MiB of private memory in every process)
+
     digest = hashlib.sha1(str(resolved).encode()).hexdigest()[:10]
     name = f"_extension_{re.sub(r'[^0-9A-Za-z_]', '_', path.stem)}_{digest}"
     if name in sys.modules:  # the same file again: the same module, as a second dlopen gives the same handle

@@ -17,12 +17,14 @@ import os
 import re
 import signal
 import socket
-import subprocess
 import threading
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import IO, TypeVar
+from typing import IO, TYPE_CHECKING, TypeVar
+
+if TYPE_CHECKING:  # imported where a child is started: most processes only use handle_signals (0.5 MiB each)
+    import subprocess
 
 log = logging.getLogger(__name__)
 
@@ -148,6 +150,8 @@ class ChildProcess:
         out = open(self.log_path, mode)  # noqa: SIM115 - closed when the child is reaped
         self._offset = out.tell()
         self._files = [out]
+        import subprocess
+
         err: IO[bytes] | int = subprocess.STDOUT
         if self.stderr_path is not None:
             err = open(self.stderr_path, mode)  # noqa: SIM115
@@ -290,6 +294,8 @@ class ChildProcess:
         """Wait for the child to end by itself; its exit status, or None on timeout."""
         if self.popen is None:
             return None
+        import subprocess
+
         try:
             return self.popen.wait(timeout)
         except subprocess.TimeoutExpired:

@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from frontseat.simulator.server import SimulatorServer
+from util.cli import HelpFormatter
 from util.logsetup import add_verbosity_argument, configure_logging
 from util.process import handle_signals
 
@@ -13,6 +14,7 @@ from util.process import handle_signals
 def main(argv: list[str] | None = None) -> int:
     """``frontseat-sim <tcp listen port>``: run the basic frontseat simulator until SIGINT/SIGTERM."""
     parser = argparse.ArgumentParser(
+        formatter_class=HelpFormatter,
         prog="frontseat-sim",
         description="Basic frontseat simulator (goby_basic_frontseat_simulator): START/CTRL/NAV/CMD over TCP.",
     )

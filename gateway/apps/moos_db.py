@@ -18,7 +18,7 @@ from gateway.moos import database
 from gateway.moos.errors import MissionFileError
 from gateway.moos.mission_file import MissionFile
 from gateway.moos.server import MoosDB
-from util.cli import bounded_number, positive_number
+from util.cli import HelpFormatter, bounded_number, positive_number
 from util.logsetup import add_verbosity_argument, configure_logging
 from util.process import handle_signals
 
@@ -64,7 +64,7 @@ def parse_response(text: str) -> dict[str, float]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="moos-db", description="A MOOSDB-compatible MOOS v10 server.")
+    parser = argparse.ArgumentParser(formatter_class=HelpFormatter, prog="moos-db", description="A MOOSDB-compatible MOOS v10 server.")
     parser.add_argument("mission_file", nargs="?", help="mission file (.moos) for ServerPort, Community, "
                         "MOOSTimeWarp and ClientTimeout (default Mission.moos if present)")
     parser.add_argument("--moos_file", help="mission file (same as the positional argument)")

@@ -21,6 +21,7 @@ from gateway.apps.moos_tool_args import (
 )
 from gateway.moos.client import comms
 from gateway.moos.clock import MoosClock
+from util.cli import HelpFormatter
 from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
@@ -48,7 +49,7 @@ def _same(sent: float | str, msg: object) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="moos-poke", description="Write MOOS variables (like uPokeDB).")
+    parser = argparse.ArgumentParser(formatter_class=HelpFormatter, prog="moos-poke", description="Write MOOS variables (like uPokeDB).")
     parser.add_argument("items", nargs="+", help="[mission.moos] VAR=value ... (VAR:=value forces a string)")
     parser.add_argument("--name", default="uPokeDB", help="client name (default uPokeDB)")
     parser.add_argument("--confirm_timeout", type=float, default=3.0, help="seconds to wait for read-back")

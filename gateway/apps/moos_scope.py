@@ -24,6 +24,7 @@ from gateway.apps.moos_tool_args import (
 from gateway.moos.client import comms
 from gateway.moos.clock import MoosClock
 from gateway.moos.message import MoosMessage
+from util.cli import HelpFormatter
 from util.logsetup import add_verbosity_argument, configure_logging
 from util.process import handle_signals
 
@@ -69,7 +70,7 @@ def render_table(names: list[str], latest: dict[str, MoosMessage], start_time: f
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="moos-scope", description="Watch MOOS variables (like uXMS).")
+    parser = argparse.ArgumentParser(formatter_class=HelpFormatter, prog="moos-scope", description="Watch MOOS variables (like uXMS).")
     parser.add_argument("items", nargs="*", help="[mission.moos] VAR ...")
     parser.add_argument("--all", action="store_true", help="show every variable (wildcard registration)")
     parser.add_argument("--name", default="uXMS", help="client name (default uXMS)")

@@ -11,6 +11,7 @@ from gateway.moos.client import comms
 from gateway.moos.clock import MAX_WARP, MoosClock
 from gateway.moos.errors import MissionFileError
 from gateway.moos.mission_file import MissionFile
+from util.cli import HelpFormatter
 from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
@@ -74,7 +75,7 @@ def adopt_db_time_warp(client: comms, clock: MoosClock) -> float:
 def parse_moos_app_args(argv: list[str] | None, prog: str, description: str, process: str) -> argparse.Namespace:
     """A MOOS application's command line, as a CMOOSApp takes it: the mission file, ``--alias NAME`` (MOOS name and
     ProcessConfig block instead of ``process``) and ``-v``; configures logging under that name."""
-    parser = argparse.ArgumentParser(prog=prog, description=description)
+    parser = argparse.ArgumentParser(formatter_class=HelpFormatter, prog=prog, description=description)
     parser.add_argument("mission", help=f".moos mission file with a ProcessConfig = {process} block")
     parser.add_argument("--alias", help=f"MOOS name (and ProcessConfig block) to use instead of {process}")
     add_verbosity_argument(parser)

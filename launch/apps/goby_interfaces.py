@@ -18,6 +18,7 @@ from launch.interfaces.analyze import AnalysisError
 from launch.interfaces.catalog import SHIPPED_APPLICATIONS, generate_text, interface_file_name
 from launch.interfaces.deployment import DEFAULT_INTERFACES_DIR, DeploymentError, load_deployment
 from launch.interfaces.visualize import VizOptions, build_graph, to_dot
+from util.cli import HelpFormatter
 from util.logsetup import add_verbosity_argument, configure_logging
 
 log = logging.getLogger(__name__)
@@ -75,7 +76,7 @@ def _visualize(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="goby-interfaces", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(formatter_class=HelpFormatter, prog="goby-interfaces", description=__doc__.splitlines()[0])
     add_verbosity_argument(parser)
     sub = parser.add_subparsers(dest="action", required=True)
     gen = sub.add_parser("generate", help="write an application's interface YAML from its code")

@@ -21,7 +21,7 @@ from pathlib import Path
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import parse_file
 from launch.process_group import ProcessGroup, child_environment
-from util.cli import bounded_number
+from util.cli import HelpFormatter, bounded_number
 from util.logsetup import add_verbosity_argument, configure_logging
 from util.process import handle_signals
 
@@ -44,6 +44,7 @@ _UNSUPPORTED_MODES = {
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
+        formatter_class=HelpFormatter,
         prog="goby-launch",
         description="Launch the processes of a goby_launch launch file; Ctrl-C stops them in reverse order.",
     )

@@ -27,6 +27,7 @@ from launch.trail.operator import SCHEDULE_HELP, Operator, PortalWorker, parse_t
 from launch.trail.plot import write_trail_png
 from launch.trail.settings import TrailSettings, Vehicle
 from launch.trail.summary import progress_line, summary_text
+from util.cli import HelpFormatter
 from util.logsetup import add_verbosity_argument
 
 log = logging.getLogger(__name__)
@@ -44,7 +45,7 @@ _schedule = schedule_type(parse_trail_schedule)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m launch.trail.demo", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(formatter_class=HelpFormatter, prog="python -m launch.trail.demo", description=__doc__.split("\n\n")[0])
     parser.add_argument("--auvs", type=_auvs, default=DEFAULT_AUVS, help=f"number of AUVs (default {DEFAULT_AUVS})")
     parser.add_argument("--warp", type=_positive_int, default=DEFAULT_WARP, help=f"time warp (default {DEFAULT_WARP})")
     parser.add_argument("--duration", type=float, default=DEFAULT_DURATION_S,

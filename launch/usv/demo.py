@@ -28,6 +28,7 @@ from launch.usv.plot import write_track_png
 from launch.usv.settings import DEFAULT_SCHEDULE, KAUAI_ORIGIN, UsvSettings
 from launch.usv.shore import SCHEDULE_HELP, parse_schedule
 from launch.usv.summary import progress_line, summary_text
+from util.cli import HelpFormatter
 from util.logsetup import add_verbosity_argument
 from util.process import free_port
 
@@ -58,7 +59,7 @@ _schedule = schedule_type(parse_schedule)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m launch.usv.demo", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(formatter_class=HelpFormatter, prog="python -m launch.usv.demo", description=__doc__.split("\n\n")[0])
     parser.add_argument("--duration", type=float, default=DEFAULT_DURATION_S,
                         help=f"sim seconds to run after the helm takes command (default {DEFAULT_DURATION_S:g}; "
                         "0 = until Ctrl-C)")

@@ -43,6 +43,7 @@ from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from translators.usv.protobuf.usv_config_pb2 import CommandTool
 from translators.usv.satellite import SatelliteCommander
 from translators.usv.validation import DcclBoundsError, check_dccl_bounds
+from util.cli import HelpFormatter
 
 log = logging.getLogger(__name__)
 PROG = "usv-shore"
@@ -239,7 +240,7 @@ class ShoreOperator(SingleThreadApplication):
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(formatter_class=HelpFormatter, prog=PROG, description=__doc__.split("\n\n")[0])
     # An empty USV_SHORE_SCHEDULE counts as unset (as every USV_* variable does): no commands is spelled "none".
     parser.add_argument("--schedule", default=os.environ.get("USV_SHORE_SCHEDULE") or DEFAULT_SCHEDULE,
                         help=f"{SCHEDULE_HELP} (default $USV_SHORE_SCHEDULE or {DEFAULT_SCHEDULE})")

@@ -30,7 +30,7 @@ from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from translators.usv.protobuf.usv_config_pb2 import CommandTool
 from translators.usv.satellite import SatelliteCommander, describe_link_ack
 from translators.usv.validation import DcclBoundsError, check_dccl_bounds
-from util.cli import positive_number
+from util.cli import HelpFormatter, positive_number
 
 log = logging.getLogger(__name__)
 
@@ -44,6 +44,7 @@ PROG = "usv-command"
 def build_parser() -> argparse.ArgumentParser:
     """The command part of the command line; anything it does not know goes to the Goby config parser."""
     parser = argparse.ArgumentParser(
+        formatter_class=HelpFormatter,
         prog=PROG,
         description="Send a goby3_course.dccl.USVCommand to usv-manager and wait for its acknowledgement.",
         epilog="Other options (config file, --interprocess, -v, ...) are the usual Goby application options.",

@@ -23,6 +23,7 @@ from google.protobuf import text_format
 from gateway.goby.portal.errors import AppConfigError
 from gateway.goby.protobuf.app_config_pb2 import AppConfig
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
+from util.cli import HelpFormatter
 from util.descriptors import descriptor_of, enum_type_of, initialization_errors, message_type_of
 from util.logsetup import add_verbosity_argument
 
@@ -132,6 +133,7 @@ def project_extensions(config_type: type[pb_message.Message]) -> list[pb_descrip
 def build_parser(config_type: type[pb_message.Message], prog: str | None = None) -> argparse.ArgumentParser:
     """Goby-style command line: a config file, ``--<top-level field> VALUE`` overrides, ``-e``, ``-v``."""
     parser = argparse.ArgumentParser(
+        formatter_class=HelpFormatter,
         prog=prog,
         description=f"Configuration: {descriptor_of(config_type).full_name} in protobuf text format.",
         epilog="Message fields take text format (e.g. --interprocess 'platform: \"usv\"'); repeat an option to add "
