@@ -1,0 +1,213 @@
+"""``LogReader``: the entries of a ``.goby`` log, resynchronising at the next ``GBY3`` after anything it cannot use.
+
+Like Goby3's ``LogEntry::parse``: index entries (schemes 0xFFFF/0xFFFE) name groups and types and are not
+yielded; protobuf descriptor entries feed :attr:`LogReader.descriptors` and are not yielded either (Goby's log
+plugins consume them through a filter hook); a data entry whose index was never declared gets Goby's
+``_unknown<N>_`` name.  Unlike Goby, a log of a newer version is refused (Goby reads it as its own version), and
+every span of bytes that is not a whole valid entry is reported in :attr:`LogReader.skipped` with its offset: a
+truncated entry, a CRC mismatch, bytes between entries, an entry of a scheme Goby does not define.
+
+The file is memory-mapped: a corrupted size never allocates more than the file holds, and reading is slices.
+"""
+
+from __future__ import annotations
+
+import logging
+import mmap
+import os
+import zlib
+from collections.abc import Callable, Iterator
+
+from gateway.goby.log.descriptors import FILE_DESCRIPTOR_GROUP, FILE_DESCRIPTOR_TYPE, LogDescriptorPool
+from gateway.goby.log.entry import (
+    CRC,
+    CURRENT_VERSION,
+    HEADER,
+    HEADER_V2,
+    LEGACY_SCHEME,
+    MAGIC,
+    SCHEME_GROUP_INDEX,
+    SCHEME_PREFIX,
+    SCHEME_TYPE_INDEX,
+    VERSION,
+    VERSION_ADD_SCHEME_TO_GROUP_TYPE_MAPPING,
+    VERSION_ADD_TIMESTAMP,
+    LogEntry,
+    SkippedSpan,
+    fixed_size,
+)
+from gateway.goby.log.errors import LogFormatError, NewerVersionError
+from gateway.goby.portal.marshalling import Scheme
+
+log = logging.getLogger(__name__)
+
+#: Schemes Goby3 defines (marshalling/interface.h); entries of any other scheme are reported as skipped.
+KNOWN_SCHEMES = frozenset(int(s) for s in Scheme if s >= 0)
+
+
+def read_version(head: bytes, where: str) -> int:
+    """The format version from a log's first 4 bytes (1 when it starts with ``GBY3``: no version header)."""
+    if len(head) < VERSION.size:
+        raise LogFormatError(f"{where}: not a .goby log: {len(head)} byte(s), shorter than the version header")
+    if head[:4] == MAGIC:
+        return 1
+    (version,) = VERSION.unpack_from(head)
+    if version > CURRENT_VERSION:
+        raise NewerVersionError(
+            f"{where}: log format version {version} is newer than this reader's ({CURRENT_VERSION}): "
+            f"use a newer goby-log-tool (or this is not a .goby log)", version)
+    if version == 0:
+        raise LogFormatError(f"{where}: not a .goby log: version 0 in the header")
+    return version
+
+
+class LogReader:
+    """Iterate over a log's data entries; ``skipped`` lists what could not be read (filled while iterating).
+
+    ``on_skip(span)`` is called for each skipped span as it is found (default: a warning on this module's logger).
+    Use as a context manager or call :meth:`close`.
+    """
+
+    def __init__(self, source: str | os.PathLike[str] | bytes, *, include_descriptors: bool = False,
+                 on_skip: Callable[[SkippedSpan], None] | None = None) -> None:
+        self._mmap: mmap.mmap | None = None
+        self.name = "<bytes>"
+        if isinstance(source, bytes | bytearray | memoryview):
+            self._buf: bytes | mmap.mmap = bytes(source)
+        else:
+            self.name = str(source)
+            try:
+                with open(source, "rb") as f:
+                    size = os.fstat(f.fileno()).st_size
+                    self._buf = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) if size else b""
+            except OSError as exc:
+                raise LogFormatError(f"cannot read {self.name}: {exc.strerror or exc}") from None
+            if isinstance(self._buf, mmap.mmap):
+                self._mmap = self._buf
+        self.version = read_version(bytes(self._buf[:4]), self.name) if len(self._buf) else CURRENT_VERSION
+        self.include_descriptors = include_descriptors
+        self.descriptors = LogDescriptorPool()
+        self.skipped: list[SkippedSpan] = []
+        self.unknown_indexes: set[tuple[str, int]] = set()
+        self._on_skip = on_skip or (lambda span: log.warning("%s: %s", self.name, span))
+
+    @property
+    def size(self) -> int:
+        return len(self._buf)
+
+    def _skip(self, offset: int, length: int, reason: str) -> None:
+        span = SkippedSpan(offset, length, reason)
+        self.skipped.append(span)
+        self._on_skip(span)
+
+    def __iter__(self) -> Iterator[LogEntry]:
+        buf = self._buf
+        n = len(buf)
+        if n == 0:
+            return
+        version = self.version
+        timestamped = version >= VERSION_ADD_TIMESTAMP
+        header = HEADER if timestamped else HEADER_V2
+        hsize = header.size
+        minimum = fixed_size(version)
+        scheme_mapped = version >= VERSION_ADD_SCHEME_TO_GROUP_TYPE_MAPPING
+        groups: dict[int, dict[int, str]] = {}
+        types: dict[int, dict[int, str]] = {}
+        crc32 = zlib.crc32
+        unpack_header = header.unpack_from
+        unpack_crc = CRC.unpack_from
+        known = KNOWN_SCHEMES
+        p = 0 if version == 1 else VERSION.size
+        while p < n:
+            if buf[p:p + 4] != MAGIC:
+                q = buf.find(MAGIC, p)
+                if q < 0:
+                    if MAGIC.startswith(bytes(buf[p:n])):
+                        self._skip(p, n - p, "truncated entry at the end of the file (a part of its GBY3)")
+                    else:
+                        self._skip(p, n - p, "no entry (GBY3) in the bytes up to the end of the file")
+                    return
+                self._skip(p, q - p, "bytes between entries that are not an entry")
+                p = q
+            if p + hsize + CRC.size > n:
+                self._skip(p, n - p, "truncated entry at the end of the file (its header is incomplete)")
+                return
+            fields = unpack_header(buf, p)
+            size = fields[1]
+            end = p + 8 + size
+            if size < minimum:
+                q = buf.find(MAGIC, p + 4)
+                q = n if q < 0 else q
+                self._skip(p, q - p, f"invalid entry size {size} (at least {minimum})")
+                p = q
+                continue
+            if end > n:
+                q = buf.find(MAGIC, p + 4)
+                if q < 0:
+                    self._skip(p, n - p, f"truncated entry at the end of the file ({size + 8} bytes long, "
+                                         f"{n - p} present)")
+                    return
+                self._skip(p, q - p, f"entry size {size} runs past the end of the file (corrupt size)")
+                p = q
+                continue
+            (given,) = unpack_crc(buf, end - 4)
+            if crc32(buf[p:end - 4]) != given:
+                nxt = end if (end == n or buf[end:end + 4] == MAGIC) else buf.find(MAGIC, p + 4)
+                nxt = n if nxt < 0 else nxt
+                self._skip(p, nxt - p, f"CRC mismatch (given 0x{given:08x}, calculated "
+                                       f"0x{crc32(buf[p:end - 4]):08x})")
+                p = nxt
+                continue
+            scheme, group_index, type_index = fields[2], fields[3], fields[4]
+            timestamp = fields[5] if timestamped else 0
+            data = bytes(buf[p + hsize:end - 4])
+            offset = p
+            p = end
+            if scheme == SCHEME_GROUP_INDEX or scheme == SCHEME_TYPE_INDEX:
+                if scheme_mapped:
+                    if len(data) < SCHEME_PREFIX.size:
+                        self._skip(offset, end - offset, "index entry without its scheme")
+                        continue
+                    (owner,) = SCHEME_PREFIX.unpack_from(data)
+                    name = data[2:].decode("utf-8", "surrogateescape")
+                else:
+                    owner, name = LEGACY_SCHEME, data.decode("utf-8", "surrogateescape")
+                if scheme == SCHEME_GROUP_INDEX:
+                    groups.setdefault(owner, {})[group_index] = name
+                else:
+                    types.setdefault(owner, {})[type_index] = name
+                continue
+            if scheme not in known:
+                self._skip(offset, end - offset, f"entry of unknown scheme {scheme}")
+                continue
+            key = scheme if scheme_mapped else LEGACY_SCHEME
+            type_name = types.get(key, {}).get(type_index)
+            if type_name is None:
+                type_name = f"_unknown{type_index}_"
+                self._unknown("type", type_index)
+            group = groups.get(key, {}).get(group_index)
+            if group is None:
+                group = f"_unknown{group_index}_"
+                self._unknown("group", group_index)
+            if scheme == Scheme.PROTOBUF and type_name == FILE_DESCRIPTOR_TYPE and group == FILE_DESCRIPTOR_GROUP:
+                self.descriptors.add_file(data)
+                if not self.include_descriptors:
+                    continue
+            yield LogEntry(scheme, group, type_name, timestamp, data, offset)
+
+    def _unknown(self, what: str, index: int) -> None:
+        if (what, index) not in self.unknown_indexes:
+            self.unknown_indexes.add((what, index))
+            log.warning("%s: no %s entry in file for %s index: %d", self.name, what, what, index)
+
+    def close(self) -> None:
+        if self._mmap is not None:
+            self._mmap.close()
+            self._mmap = None
+            self._buf = b""
+
+    def __enter__(self) -> LogReader:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
