@@ -12,7 +12,7 @@ $(BIN)/python:
 	$(BIN)/python -m pip install --upgrade --quiet pip
 
 $(VENV)/.installed: pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[test,demo,lint]'
+	$(BIN)/python -m pip install --quiet -e '.[test,demo,lint,log]'
 	touch $@
 
 MISSION ?= trail
