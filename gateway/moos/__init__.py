@@ -9,7 +9,8 @@ without ``clock=``); everything else gives its client a clock of its own.
 
 from __future__ import annotations
 
-from .client import comms
+from typing import TYPE_CHECKING, Any
+
 from .clock import DEFAULT_CLOCK, MoosClock
 from .errors import (
     ConnectionClosedError,
@@ -19,8 +20,25 @@ from .errors import (
     PoisonedError,
     ProtocolError,
 )
-from .factory import ClientChoice, choose_client
 from .message import MoosMessage
+
+if TYPE_CHECKING:
+    from .client import comms
+    from .factory import ClientChoice, choose_client
+
+# The client (and its engine) load on first use: moos-db, which only serves, never pays for them (2 MiB).
+_LAZY = {"comms": ".client", "ClientChoice": ".factory", "choose_client": ".factory"}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(module, __name__), name)
+    globals()[name] = value
+    return value
 
 moos_msg = MoosMessage  # pymoos's name for the message class
 pyMOOSException = MoosError  # pymoos's exception name  # noqa: N816
