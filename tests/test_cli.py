@@ -62,3 +62,13 @@ def test_columns_fall_back_when_unset_or_bad(monkeypatch: pytest.MonkeyPatch) ->
     assert terminal_columns(fallback=77) in (77, *range(1, 10_000))  # a terminal on stdout, if any, wins
     monkeypatch.setattr(sys, "__stdout__", None)
     assert terminal_columns(fallback=77) == 77
+
+
+def test_moos_db_starts_without_the_client_engine_or_dataclasses() -> None:
+    """moos-db only serves: the client's engine and dataclasses (which imports inspect) stay out of it."""
+    script = ("import json, sys; from gateway.apps.moos_db import build_parser; build_parser().format_help(); "
+              "print(json.dumps(sorted(m for m in ('gateway.moos.client', 'gateway.moos.engine', 'dataclasses', "
+              "'inspect') if m in sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO,
+                         env={**os.environ, "PYTHONPATH": str(REPO)}, timeout=60, check=True)
+    assert json.loads(out.stdout.splitlines()[-1]) == []
