@@ -40,6 +40,11 @@ class BenchEcho(Translator):
         if {tick_only}:
             self.moos().comms().set_on_mail_callback(lambda: True)  # Goby's way: fetch only in the 10 Hz loop
 
+    if {tick_only}:
+        def loop(self):  # overriding loop() also makes the thread tick at Goby's 10 Hz x warp
+            super().loop()
+            self.moos().handle_mail()
+
     def on_in(self, msg):
         self.goby().interprocess().publish("bench_from_moos", msg.string())
 

@@ -3,8 +3,14 @@
 Why this shape (python-can's bridge is two listeners): the MOOS side (``moos()``: triggers, buffers, the
 client) and the Goby side (``goby()``: interprocess/interthread subscriptions) each forward into the other, and
 *every* callback of both sides runs on this translator's own thread, never concurrently, so translator code needs
-no locks.  MOOS mail is handled as soon as it arrives: the client's I/O thread only wakes this thread with
-``call_soon``; this thread then fetches and dispatches the batch (Goby waits for its next 10 Hz tick).
+no locks.  The MOOS client lives on the thread's reactor (``comms(reactor=self.reactor)``; no I/O thread): its
+socket is one more source the thread waits on, so MOOS mail is dispatched the moment it is read (Goby waits for its
+next 10 Hz tick).  With the real pymoos (``GOBY_MOOS_CLIENT=pymoos``) the client keeps its own I/O thread, which
+only wakes this thread with ``call_soon``.
+
+The thread wakes only for work: mail, Goby messages, and its tick.  The tick is Goby's 10 Hz x warp for a subclass
+that overrides ``loop()``; otherwise its only work is ``GOBY_MOOS_TRANSLATOR_TIME``, so it runs once per simulated
+second (:meth:`Translator.tick_frequency_hz`).
 
 Subclass, set up triggers and subscriptions in ``__init__``, and launch it from a plugin's ``load(gateway)``
 with ``gateway.launch_thread(MyTranslator)``.
@@ -19,7 +25,7 @@ from collections.abc import Callable
 from gateway.goby.portal import MultiThreadApplication, SimpleThread
 from gateway.moos import MoosClock, choose_client
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
-from translators.moos_interface import TIME_VAR, MOOSInterface
+from translators.moos_interface import TIME_PUBLISH_PERIOD_S, TIME_VAR, MOOSInterface
 
 log = logging.getLogger(__name__)
 
@@ -39,11 +45,12 @@ class Translator(SimpleThread):
     behind).  Triggers and buffers added before or after the connection are (re-)registered on every connect.
 
     ``comms_kind`` picks the client (``"ours"``, ``"pymoos"``, ``"auto"``; default ``GOBY_MOOS_CLIENT`` or ours),
-    see ``gateway.moos.choose_client``.
+    see ``gateway.moos.choose_client``.  Ours lives on this thread's reactor, so its on-connect and on-mail
+    callbacks run here directly (and ``comms().wait_until_connected`` cannot wait here: use ``is_connected``).
     """
 
     def __init__(self, cfg: GobyMOOSGatewayConfig, index: int = -1, *, comms_kind: str | None = None) -> None:
-        super().__init__(cfg, LOOP_FREQUENCY_HZ, index)
+        super().__init__(cfg, self.tick_frequency_hz(), index)
         # Goby3 (moos_plugin_translator.h translator_name()) streams std::this_thread::get_id(), which libstdc++
         # prints as the pthread_t; threading.get_ident() is that same pthread_self() value. With address-space
         # randomisation it differs between processes, so two gateways on one MOOSDB do not clash.
@@ -53,14 +60,21 @@ class Translator(SimpleThread):
         # of different gateways (or tests) in one process neither share a warp nor overwrite each other's skew.
         # (The real pymoos has only the process-wide clock: choose_client applies this warp to it.)
         self._moos_clock = MoosClock(float(sim.warp_factor) if sim.use_sim_time else 1.0)
-        client = choose_client(comms_kind, clock=self._moos_clock)
+        client = choose_client(comms_kind, clock=self._moos_clock, reactor=self.reactor)
         self._moos = MOOSInterface(
             client.comms,
-            self.call_soon,
+            None if client.reactor is self.reactor else self.call_soon,  # pymoos: hand over from its I/O thread
             moos_time=client.moos_time,
             goby_time=self.context.clock.now,
             technique=cfg.moos.moos_parser_technique,
         )
+
+    @classmethod
+    def tick_frequency_hz(cls) -> float:
+        """The loop frequency before warp: Goby's 10 Hz when ``cls`` overrides ``loop()`` (Goby's contract for
+        translator code), else once per second -- the base's own tick only posts ``GOBY_MOOS_TRANSLATOR_TIME``
+        (once per simulated second, as Goby does from its 10 Hz loop); mail never waits for a tick."""
+        return LOOP_FREQUENCY_HZ if cls.loop is not Translator.loop else 1.0 / TIME_PUBLISH_PERIOD_S
 
     def goby(self) -> Translator:
         """The Goby side: ``goby().interprocess()`` / ``goby().interthread()`` publish and subscribe.
@@ -83,16 +97,17 @@ class Translator(SimpleThread):
         return self._name
 
     def run(self) -> None:
-        """Start the MOOS client, then the thread's loop (``initialize``, ``loop`` at 10 Hz x warp, ``finalize``)."""
+        """Start the MOOS client (it connects from this thread's reactor, without blocking), then the thread's loop
+        (``initialize``, ``loop`` at :meth:`tick_frequency_hz` x warp, ``finalize``)."""
         cfg = self.cfg()
         self._moos.start(cfg.moos.server, cfg.moos.port, self._name)
         log.info("%s: MOOS client started for %s:%d", self._name, cfg.moos.server, cfg.moos.port)
         super().run()
 
     def loop(self) -> None:
-        """10 Hz x warp: posts ``GOBY_MOOS_TRANSLATOR_TIME`` about once a second and fetches leftover mail.
-
-        Subclasses that override ``loop`` must call ``super().loop()``.
+        """The tick: posts ``GOBY_MOOS_TRANSLATOR_TIME`` about once per simulated second (mail is handled as it
+        arrives, not here).  Runs once per simulated second, or at 10 Hz x warp when a subclass overrides it;
+        subclasses that override ``loop`` must call ``super().loop()``.
         """
         self._moos.loop()
 

@@ -2,8 +2,11 @@
 
 Why a separate object: it mirrors Goby's ``TranslatorBase::MOOSInterface`` (``moos().add_trigger(...)``) and
 keeps the MOOS bookkeeping apart from the Goby thread.  Threading contract: every method here is called on the
-owning translator's thread, and every trigger runs there.  The client's own I/O thread only *wakes* that thread
-(through ``call_soon``); it never touches the triggers, buffers or translator state.
+owning translator's thread, and every trigger runs there.  With our client on the translator's reactor
+(``comms(reactor=...)``, the default) the client's on-connect and on-mail callbacks already run on that thread:
+mail is dispatched inside the on-mail callback as it arrives.  With a client that has an I/O thread of its own (the
+real pymoos), that thread only *wakes* the owner through ``call_soon`` (:class:`ThreadHandOver`); it never touches
+the triggers, buffers or translator state.
 """
 
 from __future__ import annotations
@@ -29,23 +32,64 @@ def time_string(moos_time: float, goby_time: float) -> str:
     return f"moostime={moos_time:.15g},gobytime={goby_time:.15g}\n"
 
 
+class ThreadHandOver:
+    """For a client whose callbacks run on its own I/O thread (the real pymoos): they only schedule the owner's
+    work with ``call_soon``, one pending mail wake-up per burst (the owner then fetches the whole burst at once)."""
+
+    def __init__(self, call_soon: Callable[[Callable[[], Any]], None], on_connect: Callable[[], Any],
+                 on_mail: Callable[[], Any]) -> None:
+        self._call_soon = call_soon
+        self._on_connect = on_connect
+        self._on_mail = on_mail
+        self._lock = threading.Lock()
+        self._mail_pending = False
+        self.closed = False
+
+    def connected(self) -> bool:
+        """The client's on-connect callback (its I/O thread): schedules ``on_connect`` on the owner."""
+        if not self.closed:
+            self._schedule(self._on_connect)
+        return True
+
+    def mail(self) -> bool:
+        """The client's on-mail callback (its I/O thread): wakes the owner once per burst, never dispatches."""
+        with self._lock:
+            if self._mail_pending or self.closed:
+                return True
+            self._mail_pending = True
+        self._schedule(self._mail_on_owner)
+        return True
+
+    def _mail_on_owner(self) -> None:
+        with self._lock:
+            self._mail_pending = False  # cleared *before* fetching, so later mail schedules another call
+        self._on_mail()
+
+    def _schedule(self, fn: Callable[[], Any]) -> None:
+        try:
+            self._call_soon(fn)
+        except Exception:  # the owner is shutting down
+            log.debug("could not schedule %s on the translator thread", getattr(fn, "__qualname__", fn))
+
+
 class MOOSInterface:
     """Triggers, buffers and the client of one translator (Goby's ``MOOSInterface``).
 
-    ``call_soon`` is the owner thread's thread-safe scheduler; ``moos_time``/``goby_time`` return MOOS time and
-    (warped) Goby time in seconds.  Nothing is unregistered: as in Goby there is no unsubscribe.
+    ``call_soon``: None when the client's callbacks run on the owner's thread (our client on the owner's reactor);
+    else the owner thread's thread-safe scheduler, through which a client with an I/O thread of its own hands over
+    (:class:`ThreadHandOver`).  ``moos_time``/``goby_time`` return MOOS time and (warped) Goby time in seconds.
+    Nothing is unregistered: as in Goby there is no unsubscribe.
     """
 
     def __init__(
         self,
         comms: Any,
-        call_soon: Callable[[Callable[[], Any]], None],
+        call_soon: Callable[[Callable[[], Any]], None] | None,
         moos_time: Callable[[], float],
         goby_time: Callable[[], float],
         technique: int = Technique.PREFIXED_PROTOBUF_TEXT_FORMAT,
     ) -> None:
         self._comms = comms
-        self._call_soon = call_soon
         self._moos_time = moos_time
         self._goby_time = goby_time
         self.technique = Technique(technique)
@@ -54,13 +98,17 @@ class MOOSInterface:
         self._buffer_vars: set[str] = set()
         self._buffer: dict[str, Any] = {}
         self._next_time_publish = goby_time()
-        self._wake_lock = threading.Lock()
-        self._mail_pending = False
         self._closed = False
         self._started = False
         self.mail_batches = 0  # how many fetch batches were handled (for tests and benchmarks)
-        comms.set_on_connect_callback(self._on_connect_io)
-        comms.set_on_mail_callback(self._on_mail_io)
+        self._hand_over: ThreadHandOver | None = None
+        if call_soon is None:  # the callbacks run on this thread: register and dispatch right there
+            comms.set_on_connect_callback(self._on_connect)
+            comms.set_on_mail_callback(self._on_mail)
+        else:
+            self._hand_over = ThreadHandOver(call_soon, self._on_connect, self.handle_mail)
+            comms.set_on_connect_callback(self._hand_over.connected)
+            comms.set_on_mail_callback(self._hand_over.mail)
 
     # ------------------------------------------------------------------------------ translator API
     def comms(self) -> Any:
@@ -130,20 +178,19 @@ class MOOSInterface:
 
     # ------------------------------------------------------------------------------ owner thread
     def loop(self) -> None:
-        """The 10 Hz tick: post the time variable about once a second, and fetch any mail left (safety net)."""
+        """The translator's tick: post the time variable when a (Goby-clock) second has passed since the last.
+
+        Mail is not fetched here: it is dispatched as it arrives (:meth:`handle_mail`)."""
         now = self._goby_time()
         if now > self._next_time_publish:
             self._comms.notify(TIME_VAR, time_string(self._moos_time(), now))
             self._next_time_publish += TIME_PUBLISH_PERIOD_S
             if self._next_time_publish < now - TIME_PUBLISH_PERIOD_S:  # e.g. after a long stall: do not burst
                 self._next_time_publish = now
-        self.handle_mail()
 
     def handle_mail(self) -> int:
         """Fetch everything received and dispatch it: buffers for the whole batch first, then per message the
         exact trigger and the wildcard triggers.  Returns the number of messages handled."""
-        with self._wake_lock:
-            self._mail_pending = False  # cleared *before* fetching, so later mail schedules another call
         mail = self._comms.fetch()
         if not mail:
             return 0
@@ -195,27 +242,20 @@ class MOOSInterface:
         if self._closed:
             return
         self._closed = True
+        if self._hand_over is not None:
+            self._hand_over.closed = True
         if self._started:
             self._comms.close(True)
 
-    # ------------------------------------------------------------------------------ client I/O thread
-    def _on_connect_io(self) -> bool:
-        """Runs on the MOOS client's I/O thread: only schedules :meth:`register_all` on the owner thread."""
+    # ------------------------------------------------------------------------------ client callbacks
+    def _on_connect(self) -> bool:
+        """After every (re)connect, on the owner thread (directly, or handed over): register everything."""
         if not self._closed:
-            self._schedule(self.register_all)
+            self.register_all()
         return True
 
-    def _on_mail_io(self) -> bool:
-        """Runs on the MOOS client's I/O thread: wakes the owner once per burst (coalesced), never dispatches."""
-        with self._wake_lock:
-            if self._mail_pending or self._closed:
-                return True
-            self._mail_pending = True
-        self._schedule(self.handle_mail)
+    def _on_mail(self) -> bool:
+        """Our client on the owner's reactor: mail has arrived; dispatch it now (posts made by the triggers leave
+        as one packet when this returns)."""
+        self.handle_mail()
         return True
-
-    def _schedule(self, fn: Callable[[], Any]) -> None:
-        try:
-            self._call_soon(fn)
-        except Exception:  # the owner is shutting down
-            log.debug("could not schedule %s on the translator thread", getattr(fn, "__name__", fn))

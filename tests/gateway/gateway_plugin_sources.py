@@ -47,3 +47,30 @@ import no_such_dependency_xyz  # noqa: F401
 def load(gateway):
     pass
 '''
+
+THREADS_PLUGIN = '''
+"""Test plugin: MOOS WHO -> MOOS THREADS, a JSON report of the thread that handled it and every thread alive."""
+import json
+import threading
+
+from translators.base import Translator
+
+
+class ThreadsTranslator(Translator):
+    def __init__(self, cfg):
+        super().__init__(cfg)
+        self.constructed_on = threading.get_ident()
+        self.moos().add_trigger("WHO", self.on_who)
+
+    def on_who(self, msg):
+        self.moos().comms().notify("THREADS", json.dumps({
+            "constructed_on": self.constructed_on,
+            "handled_on": threading.get_ident(),
+            "handler_thread": threading.current_thread().name,
+            "threads": sorted(t.name for t in threading.enumerate()),
+        }))
+
+
+def load(gateway):
+    gateway.launch_thread(ThreadsTranslator)
+'''

@@ -97,8 +97,8 @@ def test_gateway_process_end_to_end(tmp_path, moosdb_kind, stop_signal):
 
 
 def test_warp_speeds_up_the_translator_clock(tmp_path):
-    """With ``use_sim_time`` and warp 10, the loop runs at 100 Hz and the time variable comes ~10 times a second,
-    carrying warped MOOS and Goby times."""
+    """With ``use_sim_time`` and warp 10, the translator ticks once per simulated second (its plugin does not
+    override ``loop()``), so the time variable comes ~10 times a real second, carrying warped MOOS and Goby times."""
     plugin = tmp_path / "echo_plugin.py"
     plugin.write_text(ECHO_PLUGIN)
     with moosdb_process(tmp_path, warp=10) as db, broker_process(tmp_path, platform="gwwarp") as broker:

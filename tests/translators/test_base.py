@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import queue
 import re
+import sys
 import threading
 import time
+import types
 from typing import Any
 
 import pytest
@@ -39,6 +41,7 @@ class RecordingTranslator(Translator):
     def on_in(self, msg) -> None:
         b = self.moos().buffer().get("B")
         EVENTS.put(("in", threading.get_ident(), msg.string()))
+        EVENTS.put(("threads", threading.get_ident(), sorted(t.name for t in threading.enumerate())))
         self.goby().interprocess().publish("from_moos", f"{msg.string()}|{b.double() if b else 'none'}")
 
     def never(self, msg) -> None:
@@ -52,11 +55,41 @@ class RecordingTranslator(Translator):
         self.moos().comms().notify("OUT", text.upper())
 
 
-class WakeOnlyTranslator(RecordingTranslator):
-    """Same, but its 10 Hz loop does nothing: MOOS mail can only reach it through the on-mail wake-up."""
+class LoopingTranslator(RecordingTranslator):
+    """Same, with a ``loop()`` of its own: it runs at Goby's 10 Hz (x warp); mail still does not wait for it."""
 
     def loop(self) -> None:
-        pass
+        super().loop()
+        EVENTS.put(("loop", threading.get_ident(), None))
+
+
+class PymoosStandInTranslator(RecordingTranslator):
+    """Same, on the ``pymoos`` client kind: the ``pymoos_stand_in`` fixture makes that our client with an I/O thread
+    of its own (as the real pymoos has), so its callbacks are handed over to the translator thread."""
+
+    def __init__(self, cfg) -> None:
+        Translator.__init__(self, cfg, comms_kind="pymoos")
+        self.ident = threading.get_ident()
+        EVENTS.put(("constructed", self.ident, self.translator_name()))
+        self.moos().add_buffer("B")
+        self.moos().add_trigger("IN", self.on_in)
+        self.moos().add_trigger("IN", self.never)
+        self.moos().add_wildcard_trigger("W_*", "poster", self.on_wild)
+        self.goby().interprocess().subscribe("to_moos", str, self.on_goby)
+
+
+@pytest.fixture
+def pymoos_stand_in(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A ``pymoos`` module whose ``comms`` is our client without a reactor: callbacks on its own I/O thread."""
+    from gateway.moos.client import comms
+    from gateway.moos.clock import MoosClock
+
+    clock = MoosClock()
+    fake = types.ModuleType("pymoos")
+    fake.comms = lambda: comms(clock=clock)  # type: ignore[attr-defined]
+    fake.time = clock.time  # type: ignore[attr-defined]
+    fake.set_moos_timewarp = clock.set_warp  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "pymoos", fake)
 
 
 def _events_until(kind: str, count: int = 1, timeout: float = 20.0) -> list[tuple[str, int, Any]]:
@@ -77,8 +110,21 @@ def infrastructure(tmp_path):
         yield db, broker
 
 
-@pytest.mark.parametrize("translator_class", [RecordingTranslator, WakeOnlyTranslator])
-def test_both_directions_on_the_translator_thread(infrastructure, translator_class):
+def test_tick_frequency_follows_whether_loop_is_overridden():
+    """Goby's 10 Hz for translator code with a loop of its own; else once a second (the time variable)."""
+    from translators.frontseat.translation import FrontSeatTranslation
+
+    assert RecordingTranslator.tick_frequency_hz() == 1.0
+    assert FrontSeatTranslation.tick_frequency_hz() == 1.0
+    assert LoopingTranslator.tick_frequency_hz() == 10.0
+
+
+@pytest.mark.parametrize("translator_class", [RecordingTranslator, LoopingTranslator, PymoosStandInTranslator])
+def test_both_directions_on_the_translator_thread(infrastructure, translator_class, request):
+    """Every callback runs on the translator's thread. Our client lives on that thread's reactor (no MOOS I/O
+    thread); a client with an I/O thread of its own (pymoos's kind) hands mail over to it."""
+    if translator_class is PymoosStandInTranslator:
+        request.getfixturevalue("pymoos_stand_in")
     db, broker = infrastructure
     cfg = gateway_config(db.port, broker.interprocess_config())
     with PortalClient(broker.interprocess_config(), name="peer") as peer, \
@@ -98,9 +144,13 @@ def test_both_directions_on_the_translator_thread(infrastructure, translator_cla
                 if peer.poll_until(lambda: bool(from_moos), 0.2):
                     break
             assert from_moos and from_moos[0].startswith("hello") and from_moos[0].endswith("|7.5")
-            events = _events_until("in")
-            assert all(e[1] == ident for e in events if e[0] in ("in", "duplicate"))
+            events = _events_until("threads")
+            assert all(e[1] == ident for e in events if e[0] in ("in", "duplicate", "threads", "loop"))
             assert not [e for e in events if e[0] == "duplicate"]
+            # the MOOS I/O thread of this translator's client: none on the reactor, pymoos's kind has one
+            io_thread = f"moos-comms-{name}"
+            thread_names = next(e[2] for e in events if e[0] == "threads")
+            assert (io_thread in thread_names) == (translator_class is PymoosStandInTranslator), thread_names
             # wildcard trigger: name and source globs
             poster.notify("W_ONE", 1.0)
             wild = [e for e in _events_until("wild") if e[0] == "wild"]

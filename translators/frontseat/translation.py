@@ -13,7 +13,8 @@ thread when embedded (Goby's forwarder threads get it from the portal's inner pu
 moos-gateway.
 
 The thread wakes only for work: MOOS mail and node_status as they arrive, and once per simulated second for
-``GOBY_MOOS_TRANSLATOR_TIME`` (Goby's 10 Hz x warp tick has nothing else left to do here).
+``GOBY_MOOS_TRANSLATOR_TIME`` (it does not override ``loop()``, so the base ticks once per simulated second: Goby's
+10 Hz x warp tick would have nothing else to do here).
 """
 
 from __future__ import annotations
@@ -36,7 +37,6 @@ from translators.frontseat.helm_conversion import (
     helm_state,
 )
 from translators.frontseat.nav_conversion import nav_posts
-from translators.moos_interface import TIME_PUBLISH_PERIOD_S
 from util.geodesy import UTMGeodesy
 
 log = logging.getLogger(__name__)
@@ -71,11 +71,6 @@ class FrontSeatTranslation(Translator):
         else:
             interprocess.subscribe(groups.node_status, NodeStatus, self._on_node_status)
         interprocess.subscribe(groups.datum_update, DatumUpdate, self._on_datum_update)
-
-    def effective_loop_frequency_hz(self) -> float:
-        """Once per simulated second: the tick's only work is ``GOBY_MOOS_TRANSLATOR_TIME`` (Goby posts it once per
-        warped second from its 10 Hz loop); mail and node_status are handled as they arrive, not by the tick."""
-        return self.context.clock.effective_warp / TIME_PUBLISH_PERIOD_S
 
     def _on_node_status(self, status: NodeStatus) -> None:
         """Post NAV_* for one NodeStatus. Runs on the translator's thread."""
