@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import Any
 
 from .behavior import Behavior, parse_float
-from .ivp import ObjectiveFunction, zaic_peak
+from .ivp import ObjectiveFunction, zaic_piece
 
 
 class _ConstantBehavior(Behavior):
@@ -47,7 +47,7 @@ class _ConstantBehavior(Behavior):
             if actual is not None:
                 error = abs(actual - self.desired)
                 self.post(self.mismatch_var, round(min(error, 360 - error) if self.WRAP else error, 2))
-        utilities = zaic_peak(var, self.summit(), self.peakwidth, self.basewidth, self.summitdelta,
+        utilities = zaic_piece(var, self.summit(), self.peakwidth, self.basewidth, self.summitdelta,
                               0, 100, wrap=self.WRAP)
         return ObjectiveFunction.single(self.pwt, self.VAR, utilities)
 

@@ -9,7 +9,7 @@ from .behavior import Behavior, parse_bool, parse_float
 from .cruise_speed import CruiseSpeed
 from .errors import ParamError
 from .geometry import Polygon, fmt_num, rel_ang, segment_angle
-from .ivp import ObjectiveFunction, zaic_peak
+from .ivp import ObjectiveFunction, zaic_piece
 from .point_strings import parse_point, parse_polygon
 from .waypoint_engine import WaypointEngine
 
@@ -188,8 +188,8 @@ class LoiterBehavior(CruiseSpeed, Behavior):
         self._post_status(dist)
         self.post("VIEW_POLYGON", f"{self.polygon.spec()},label={self.ownship}_{self.name}")
         course, speed = self.domain.vars["course"], self.domain.vars["speed"]
-        spd = zaic_peak(speed, self.cruise_speed(), 0, 0.3, 0, 0, 100)
-        crs = zaic_peak(course, rel_ang(osx, osy, self._ptx, self._pty), 0, 180, 0, 0, 100, wrap=True)
+        spd = zaic_piece(speed, self.cruise_speed(), 0, 0.3, 0, 0, 100)
+        crs = zaic_piece(course, rel_ang(osx, osy, self._ptx, self._pty), 0, 180, 0, 0, 100, wrap=True)
         return ObjectiveFunction.coupled(self.pwt, "course", crs, self.patience, "speed", spd, 100 - self.patience)
 
     def _update_mode(self, dist: float) -> None:

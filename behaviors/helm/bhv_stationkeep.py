@@ -8,7 +8,7 @@ from typing import Any
 from .behavior import Behavior, parse_bool, parse_float
 from .errors import ParamError
 from .geometry import Point, fmt_num, rel_ang
-from .ivp import ObjectiveFunction, zaic_peak
+from .ivp import ObjectiveFunction, zaic_piece
 from .point_strings import parse_point
 
 
@@ -87,6 +87,6 @@ class StationKeepBehavior(Behavior):
             self.post("VIEW_POLYGON", f"radial:: x={fmt_num(sx)},y={fmt_num(sy)},radius={fmt_num(radius)},pts=32,"
                                       f"label={self.ownship}:station-keep-{label}", key=label)
         dom_s, dom_c = self.domain.vars["speed"], self.domain.vars["course"]
-        spd = zaic_peak(dom_s, min(speed, dom_s.high), 0, 0.4, 0, 0, 25)
-        crs = zaic_peak(dom_c, course, 0, 180, 0, 0, 100, wrap=True)
+        spd = zaic_piece(dom_s, min(speed, dom_s.high), 0, 0.4, 0, 0, 25)
+        crs = zaic_piece(dom_c, course, 0, 180, 0, 0, 100, wrap=True)
         return ObjectiveFunction.coupled(self.pwt, "course", crs, 50, "speed", spd, 50)

@@ -23,7 +23,7 @@ from .behavior import parse_bool, parse_float
 from .bhv_contact import ContactBehavior
 from .errors import ParamError
 from .geometry import angle180, fmt_num, project, rel_ang
-from .ivp import ObjectiveFunction, zaic_peak
+from .ivp import ObjectiveFunction, zaic_piece
 
 
 def _int_value(value: float) -> float:
@@ -135,8 +135,8 @@ class TrailBehavior(ContactBehavior):
 
     def _course_speed(self, pwt: float, heading: float, speed: float) -> ObjectiveFunction:
         """ZAIC_PEAK on course (peak 30, base 150, summit delta 50) and on speed (0.1, 2.0, 50), coupled 50/50."""
-        course = zaic_peak(self.domain.vars["course"], heading, 30, 150, 50, 0, 100, wrap=True)
-        speeds = zaic_peak(self.domain.vars["speed"], speed, 0.1, 2.0, 50, 0, 100)
+        course = zaic_piece(self.domain.vars["course"], heading, 30, 150, 50, 0, 100, wrap=True)
+        speeds = zaic_piece(self.domain.vars["speed"], speed, 0.1, 2.0, 50, 0, 100)
         return ObjectiveFunction.coupled(pwt, "course", course, 50, "speed", speeds, 50)
 
     def _calculate_trail_point(self) -> None:

@@ -10,7 +10,7 @@ from .cruise_speed import CruiseSpeed
 from .errors import ParamError
 from .flags import Flag
 from .geometry import Point, fmt_num, perp_on_segment, project, rel_ang
-from .ivp import ObjectiveFunction, zaic_peak
+from .ivp import ObjectiveFunction, zaic_peak, zaic_piece
 from .point_strings import parse_point, parse_seglist
 from .waypoint_engine import WaypointEngine
 
@@ -250,7 +250,7 @@ class WaypointBehavior(CruiseSpeed, Behavior):
     def _build_of(self, bearing: float, heading: float) -> ObjectiveFunction:
         course, speed = self.domain.vars["course"], self.domain.vars["speed"]
         cruise = self.cruise_speed()
-        spd = zaic_peak(speed, cruise, cruise / 2, 1.6, 20, 0, 100)
+        spd = zaic_piece(speed, cruise, cruise / 2, 1.6, 20, 0, 100)
         to_target = zaic_peak(course, bearing, 0, 180, 0, 0, 100, wrap=True)
         keep_heading = zaic_peak(course, heading, 30, 180, 5, 0, 20, wrap=True)
         crs = [a + b for a, b in zip(to_target, keep_heading, strict=True)]

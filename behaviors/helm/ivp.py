@@ -125,6 +125,128 @@ def zaic_peak(var: DomainVar, summit: float, peakwidth: float, basewidth: float,
     return out
 
 
+class ZaicPiece:
+    """A ZAIC_PEAK piece that builds its utilities only when asked (``values()``, the same list as
+    :func:`zaic_peak`, mapped onto [0, ``top``] by :func:`normalise` when ``top`` is set).
+
+    Why: a loiter, station-keep, trail or constant behaviour alone on its variables is the common case, and then the
+    solver needs only the piece's best grid index. The utility never rises with the distance to the summit, so the
+    best is one of the grid points either side of the summit and the lowest the point farthest from it: a handful of
+    points, evaluated with the same arithmetic as the whole list (so the choice is the same, ties included), instead
+    of a 360-point list built, normalised and scaled every iteration. Where that argument does not hold (a flat top,
+    a summit outside the base, a tiny slope) :meth:`best_index` says None and the solver builds the list.
+    """
+
+    __slots__ = ("var", "summit", "peakwidth", "basewidth", "minutil", "maxutil", "wrap", "top", "_sd",
+                 "_peak_slope", "_base_top", "_base_slope", "_outer", "_period", "_values", "_lo_hi")
+
+    def __init__(self, var: DomainVar, summit: float, peakwidth: float, basewidth: float, summitdelta: float,
+                 minutil: float = 0.0, maxutil: float = 100.0, wrap: bool = False, top: float | None = None) -> None:
+        self.var, self.summit, self.wrap, self.top = var, summit, wrap, top
+        self.peakwidth, self.basewidth, self.minutil, self.maxutil = peakwidth, basewidth, minutil, maxutil
+        self._sd = summitdelta
+        sd = summitdelta if peakwidth > 0 else 0.0
+        self._peak_slope = sd / peakwidth if peakwidth > 0 else 0.0
+        self._base_top = maxutil - sd
+        self._base_slope = (self._base_top - minutil) / basewidth if basewidth > 0 else 0.0
+        self._outer = peakwidth + basewidth
+        self._period = var.high - var.low + var.delta
+        self._values: list[float] | None = None
+        self._lo_hi: tuple[float, float] | None = None
+
+    def normalised(self, top: float) -> ZaicPiece:
+        """This piece mapped onto [0, top] (:func:`normalise`), still unbuilt."""
+        return ZaicPiece(self.var, self.summit, self.peakwidth, self.basewidth, self._sd, self.minutil,
+                         self.maxutil, self.wrap, top)
+
+    def values(self) -> list[float]:
+        """The whole list: :func:`zaic_peak`, then :func:`normalise` when ``top`` is set (built once)."""
+        if self._values is None:
+            raw = zaic_peak(self.var, self.summit, self.peakwidth, self.basewidth, self._sd, self.minutil,
+                            self.maxutil, self.wrap)
+            self._values = raw if self.top is None else normalise(raw, self.top)
+        return self._values
+
+    def _raw_at(self, j: int) -> float:
+        """Grid point ``j`` of :func:`zaic_peak`'s list, by the same arithmetic (before its all-minutil fix)."""
+        d = abs(self.var._grid[j] - self.summit)
+        if self.wrap:
+            e = d % self._period
+            d = e if e <= self._period - e else self._period - e
+        if d <= self.peakwidth:
+            return self.maxutil - self._peak_slope * d
+        if d <= self._outer:
+            return self._base_top - self._base_slope * (d - self.peakwidth)
+        return self.minutil
+
+    def _around(self, position: float) -> list[int]:
+        """The grid indices next to ``position`` (two either side: slack for rounding), wrapped or clipped."""
+        var = self.var
+        n = var.points
+        if self.wrap:
+            k = math.floor(((position - var.low) % self._period) / var.delta)
+            return sorted({(k + i) % n for i in range(-1, 3)})
+        k = min(max(math.floor((position - var.low) / var.delta), 0), n - 1)  # a summit outside: its nearest end
+        return [j for j in range(k - 1, k + 3) if 0 <= j < n]
+
+    def best_index(self) -> tuple[list[int], list[float], float] | None:
+        """Where the maximum must be: grid indices, this piece's values there (the list's, exactly), and the least
+        amount by which every other point is lower; None where that does not hold (then build the list)."""
+        var = self.var
+        slopes = [self._peak_slope] if self.peakwidth > 0 else []
+        if self.basewidth > 0:
+            slopes.append(self._base_slope)
+        step = min(slopes, default=0.0) * var.delta
+        if var.points < 4 or not 1e-9 <= step < math.inf:
+            return None  # a flat top or base (the first of many equal maxima may be anywhere on it), or no slope at all
+        near = self._around(self.summit)
+        raw = [self._raw_at(j) for j in near]
+        if max(raw) <= self.minutil:
+            return None  # the summit is beyond every point's reach: zaic_peak's nearest-point rule applies
+        if self.top is None:
+            return near, raw, step
+        lo_hi = self._extremes(max(raw))
+        if lo_hi is None:
+            return None
+        lo, hi = lo_hi
+        span = hi - lo
+        return near, [self.top * (u - lo) / span for u in raw], step * self.top / span
+
+    def _extremes(self, hi: float) -> tuple[float, float] | None:
+        """min and max of the unnormalised list (``hi``: its maximum), or None when they are equal."""
+        if self._lo_hi is None:
+            far = self._around(self.summit + self._period / 2) if self.wrap else [0, self.var.points - 1]
+            self._lo_hi = (min(self._raw_at(j) for j in far), hi)
+        lo, hi = self._lo_hi
+        return None if hi == lo else (lo, hi)
+
+    def spread(self) -> float | None:
+        """max - min of the (unnormalised) list without building it, or None when unsure."""
+        found = self.best_index() if self.top is None else None
+        if found is None:
+            return None
+        lo_hi = self._extremes(max(found[1]))
+        return 0.0 if lo_hi is None else lo_hi[1] - lo_hi[0]
+
+
+Piece = list[float] | ZaicPiece
+
+
+def zaic_piece(var: DomainVar, summit: float, peakwidth: float, basewidth: float, summitdelta: float,
+               minutil: float = 0.0, maxutil: float = 100.0, wrap: bool = False) -> ZaicPiece:
+    """:func:`zaic_peak` as a :class:`ZaicPiece`: built only if the solver needs more than its best point."""
+    return ZaicPiece(var, summit, peakwidth, basewidth, summitdelta, minutil, maxutil, wrap)
+
+
+def _normalised(piece: Piece, top: float) -> Piece:
+    return piece.normalised(top) if isinstance(piece, ZaicPiece) and piece.top is None else normalise(
+        _listed(piece), top)
+
+
+def _listed(piece: Piece) -> list[float]:
+    return piece.values() if isinstance(piece, ZaicPiece) else piece
+
+
 def normalise(values: list[float], top: float) -> list[float]:
     """Affinely map ``values`` onto [0, top] (OF_Coupler's per-piece normalisation)."""
     lo, hi = min(values), max(values)
@@ -140,7 +262,7 @@ class ObjectiveFunction:
     table ``joint = (var1, var2, rows)`` with ``rows[i][j]`` the utility at var1's i-th and var2's j-th grid value."""
 
     pwt: float
-    pieces: dict[str, list[float]] = field(default_factory=dict)
+    pieces: dict[str, Piece] = field(default_factory=dict)
     joint: tuple[str, str, list[list[float]]] | None = None
 
     @classmethod
@@ -152,18 +274,24 @@ class ObjectiveFunction:
         return cls(pwt, joint=(var1, var2, [[(u - lo) * scale for u in row] for row in rows]))
 
     @classmethod
-    def single(cls, pwt: float, var: str, utilities: list[float]) -> ObjectiveFunction:
+    def single(cls, pwt: float, var: str, utilities: Piece) -> ObjectiveFunction:
         """A one-variable ZAIC; its 0..100 range is kept (the helm rescales only ranges above 100)."""
-        if max(utilities) - min(utilities) > 100:
+        if isinstance(utilities, ZaicPiece):
+            spread = utilities.spread()
+            if spread is None:
+                utilities = utilities.values()
+            elif spread > 100:
+                utilities = utilities.normalised(100.0)
+        if isinstance(utilities, list) and max(utilities) - min(utilities) > 100:
             utilities = normalise(utilities, 100.0)
         return cls(pwt, {var: utilities})
 
     @classmethod
-    def coupled(cls, pwt: float, var1: str, u1: list[float], w1: float,
-                var2: str, u2: list[float], w2: float) -> ObjectiveFunction:
+    def coupled(cls, pwt: float, var1: str, u1: Piece, w1: float,
+                var2: str, u2: Piece, w2: float) -> ObjectiveFunction:
         """OF_Coupler: each piece normalised to [0, w]; the weights add to 100."""
         total = w1 + w2
-        return cls(pwt, {var1: normalise(u1, 100.0 * w1 / total), var2: normalise(u2, 100.0 * w2 / total)})
+        return cls(pwt, {var1: _normalised(u1, 100.0 * w1 / total), var2: _normalised(u2, 100.0 * w2 / total)})
 
 
 def solve(domain: IvPDomain, functions: list[ObjectiveFunction]) -> dict[str, float]:
@@ -181,10 +309,13 @@ def solve(domain: IvPDomain, functions: list[ObjectiveFunction]) -> dict[str, fl
     for name, var in domain.vars.items():
         if name in coupled:
             continue
-        scores = _separable_scores(name, var, active)
-        if scores is not None:
+        best = _best_of_one_zaic(name, active)
+        if best is None:
+            scores = _separable_scores(name, var, active)
+            if scores is None:
+                continue
             best = scores.index(max(scores))  # the first maximum: lowest index
-            decisions[name] = var.low + best * var.delta
+        decisions[name] = var.low + best * var.delta
     for name1, name2 in pairs:
         var1, var2 = domain.vars[name1], domain.vars[name2]
         total: list[list[float]] | None = None
@@ -211,13 +342,39 @@ def solve(domain: IvPDomain, functions: list[ObjectiveFunction]) -> dict[str, fl
     return decisions
 
 
-def _separable_scores(name: str, var: DomainVar, functions: list[ObjectiveFunction]) -> list[float] | None:
-    """Σ pwt·piece over the functions with a one-variable piece for ``name``; None if there is none."""
-    scores: list[float] | None = None
+def _best_of_one_zaic(name: str, functions: list[ObjectiveFunction]) -> int | None:
+    """The best grid index of ``name`` when its only piece is a :class:`ZaicPiece` that can tell it unbuilt: the
+    lowest index of the highest ``pwt * value`` among its candidate points (as ``scores.index(max(scores))``)."""
+    only: tuple[float, ZaicPiece] | None = None
     for fn in functions:
         piece = fn.pieces.get(name)
         if piece is None:
             continue
+        if only is not None or not isinstance(piece, ZaicPiece):
+            return None
+        only = (fn.pwt, piece)
+    if only is None:
+        return None
+    pwt, piece = only
+    found = piece.best_index()
+    if found is None:
+        return None
+    indices, values, margin = found
+    scores = [pwt * u for u in values]
+    top = max(scores)
+    if not all(math.isfinite(score) for score in scores) or not pwt * margin > 1e-9 * max(1.0, abs(top)):
+        return None  # every other point is lower, but by too little to be sure after rounding
+    return min(j for j, score in zip(indices, scores, strict=True) if score == top)
+
+
+def _separable_scores(name: str, var: DomainVar, functions: list[ObjectiveFunction]) -> list[float] | None:
+    """Σ pwt·piece over the functions with a one-variable piece for ``name``; None if there is none."""
+    scores: list[float] | None = None
+    for fn in functions:
+        found = fn.pieces.get(name)
+        if found is None:
+            continue
+        piece = _listed(found)
         pwt = fn.pwt
         if scores is None:
             scores = [pwt * u for u in piece]

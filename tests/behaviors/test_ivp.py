@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from behaviors.helm.errors import ParamError
-from behaviors.helm.ivp import IvPDomain, ObjectiveFunction, solve, zaic_peak
+from behaviors.helm.ivp import IvPDomain, ObjectiveFunction, Piece, ZaicPiece, solve, zaic_peak
 
 
 def dom() -> IvPDomain:
@@ -66,3 +68,44 @@ def test_priority_weights_decide_between_behaviours() -> None:
     assert "course" not in solve(d, [survey])
     zero = ObjectiveFunction.single(0, "speed", zaic_peak(s, 3, 0, 0.2, 0))
     assert solve(d, [zero]) == {}
+
+
+_summits = st.one_of(st.floats(-400, 800), st.integers(-10, 370).map(float), st.integers(-10, 370).map(lambda k: k + 0.5))
+_widths = st.one_of(st.just(0.0), st.floats(0, 200))
+_utils = st.sampled_from([(0.0, 100.0), (0.0, 20.0), (10.0, 100.0), (-50.0, 250.0)])
+
+
+@given(kind=st.sampled_from(["coupled", "single course", "single speed"]), course_summit=_summits,
+       speed_summit=st.one_of(st.floats(-1, 5), st.integers(0, 40).map(lambda k: k * 0.1)),
+       course_widths=st.tuples(_widths, _widths), speed_widths=st.tuples(st.floats(0, 2), st.floats(0, 3)),
+       summitdelta=st.one_of(st.just(0.0), st.floats(0, 100)), utils=_utils,
+       pwt=st.floats(0.001, 500), weights=st.tuples(st.floats(0, 100), st.floats(0, 100)).filter(lambda w: sum(w) > 0))
+@settings(max_examples=400, deadline=None)
+def test_an_unbuilt_zaic_piece_gives_the_decision_of_the_whole_list(
+        kind: str, course_summit: float, speed_summit: float, course_widths: tuple[float, float],
+        speed_widths: tuple[float, float], summitdelta: float, utils: tuple[float, float], pwt: float,
+        weights: tuple[float, float]) -> None:
+    """ZaicPiece's shortcut (the best of a handful of points) decides exactly as scoring every grid point does."""
+    d = dom()
+    course, speed = d.vars["course"], d.vars["speed"]
+
+    def functions(unbuilt: bool) -> list[ObjectiveFunction]:
+        crs: Piece = ZaicPiece(course, course_summit, *course_widths, summitdelta, *utils, wrap=True)
+        spd: Piece = ZaicPiece(speed, speed_summit, *speed_widths, summitdelta, *utils)
+        if not unbuilt:
+            crs, spd = zaic_peak(course, course_summit, *course_widths, summitdelta, *utils, wrap=True), \
+                zaic_peak(speed, speed_summit, *speed_widths, summitdelta, *utils)
+        if kind == "coupled":
+            return [ObjectiveFunction.coupled(pwt, "course", crs, weights[0], "speed", spd, weights[1])]
+        return [ObjectiveFunction.single(pwt, kind.split()[1], crs if kind == "single course" else spd)]
+
+    assert solve(d, functions(True)) == solve(d, functions(False))
+
+
+def test_a_zaic_piece_alone_is_decided_without_building_its_list() -> None:
+    d = dom()
+    crs = ZaicPiece(d.vars["course"], 123.4, 0, 180, 0, wrap=True)
+    spd = ZaicPiece(d.vars["speed"], 1.23, 0, 0.3, 0)
+    decision = solve(d, [ObjectiveFunction.coupled(100, "course", crs, 50, "speed", spd, 50)])
+    assert decision == {"course": 123.0, "speed": pytest.approx(1.2)}
+    assert crs._values is None and spd._values is None  # neither list was built
