@@ -20,6 +20,8 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+from google.protobuf import text_format
+
 from launch.config import (
     SHARED_TEMPLATES,
     config_main,
@@ -43,6 +45,7 @@ from launch.trail.settings import (
 )
 
 TEMPLATES = TRAIL_DIR / "templates"
+
 USV_BHV = REPO_ROOT / "behaviors" / "usv.bhv"
 AUV_BHV_TEMPLATE = REPO_ROOT / "behaviors" / "auv.bhv.in"
 
@@ -116,13 +119,23 @@ def link_block(settings: TrailSettings, vehicle: Vehicle, link: str) -> str:
         multicast_address: "{MULTICAST_ADDRESS}"
         multicast_port: {port}
         max_frame_size: 1400
-      }}
+      }}{_channel_block(settings, link)}
     }}
     mac {{
       type: MAC_FIXED_DECENTRALIZED
 {slot_lines}
     }}
   }}"""
+
+
+def _channel_block(settings: TrailSettings, link: str) -> str:
+    """The driver's simulated channel (our ``channel_model`` extension), when the settings impair this link."""
+    model = settings.channel_model(link)
+    if model is None:
+        return ""
+    text = text_format.MessageToString(model, as_one_line=True)
+    return (f"\n      # simulated channel on receive (TRAIL_{link.upper()}_CHANNEL, docs/intervehicle.md)"
+            f"\n      [goby_moos_py.acomms.protobuf.channel_model] {{ {text} }}")
 
 
 def broker_hosts_intervehicle() -> bool:

@@ -5,6 +5,11 @@ USV commands from the topside over the satellite link (loiter on a hexagon, then
 the USV over the acoustic link (or lets homework 3's helm send it, ``--usv-helm goby``), records every vehicle and
 both links, then writes ``trail.png``, ``trail_tracks.csv`` and ``trail_events.csv`` into the output directory and
 prints a summary. Exit status 0 only if the mission ran and every process stopped cleanly.
+
+``--acomms-loss 0.2 --acomms-delay 1-3 --satellite-loss 0.05 --satellite-outage 30`` impair the links: every
+modem driver of the link applies the channel to what it receives (our ``channel_model`` extension of the driver
+block, docs/intervehicle.md "Lossy channels"); the summary prints the channels and, per link, the commands sent,
+acked and expired.
 """
 
 from __future__ import annotations
@@ -12,11 +17,13 @@ from __future__ import annotations
 import argparse
 import csv
 import logging
+import math
 import sys
 import time
 from collections import Counter
 from pathlib import Path
 
+from gateway.goby.acomms.channel import MAX_DELAY_S, describe
 from launch.demo import add_run_arguments, demo_main, fresh_run_dir, run_mission, schedule_type, whole_number
 from launch.mission import choose_program
 from launch.record import MissionRecord, shifted
@@ -25,9 +32,9 @@ from launch.trail.links import LinkMonitor
 from launch.trail.mission import TrailMission, TrailResult, with_free_ports
 from launch.trail.operator import SCHEDULE_HELP, Operator, PortalWorker, parse_trail_schedule
 from launch.trail.plot import write_trail_png
-from launch.trail.settings import TrailSettings, Vehicle
-from launch.trail.summary import progress_line, summary_text
-from util.cli import HelpFormatter
+from launch.trail.settings import CHANNEL_LINKS, TrailSettings, Vehicle, channel_text
+from launch.trail.summary import link_accounting, progress_line, summary_text
+from util.cli import HelpFormatter, bounded_number
 from util.logsetup import add_verbosity_argument
 
 log = logging.getLogger(__name__)
@@ -42,6 +49,65 @@ MAX_SOCKET_BASE = 80  # AF_UNIX paths are limited to ~107 bytes
 _positive_int = whole_number(1)
 _auvs = whole_number(0, 64)
 _schedule = schedule_type(parse_trail_schedule)
+_probability = bounded_number(float, 0.0, 1.0)
+_seconds = bounded_number(float, 0.0, MAX_DELAY_S)
+_seed = whole_number(0)
+#: Seconds between the starts of two outages when --X-outage gives only their duration.
+DEFAULT_OUTAGE_PERIOD_S = 300.0
+
+
+def _delay(text: str) -> tuple[float, float]:
+    """``S`` or ``MIN-MAX`` seconds (each 0..3600, MIN <= MAX)."""
+    low, sep, high = text.partition("-")
+    if sep and not low:
+        raise argparse.ArgumentTypeError(f"{text!r} is not S or MIN-MAX seconds, each >= 0")
+    pair = (_seconds(low), _seconds(high)) if sep else (_seconds(text),) * 2
+    if pair[0] > pair[1]:
+        raise argparse.ArgumentTypeError(f"{text!r}: the shorter delay comes first (MIN-MAX)")
+    return pair
+
+
+def _outage(text: str) -> tuple[float, float]:
+    """``DURATION`` or ``DURATION/PERIOD`` seconds (duration <= period)."""
+    duration, sep, period = text.partition("/")
+    pair = (_seconds(duration), bounded_number(float, 0.0, math.inf, low_inclusive=False)(period) if sep
+            else DEFAULT_OUTAGE_PERIOD_S)
+    if pair[0] > pair[1]:
+        raise argparse.ArgumentTypeError(f"{text!r}: an outage cannot last longer than its period")
+    return pair
+
+
+def add_channel_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--{acomms,satellite}-{loss,delay,outage}`` and ``--channel-seed``."""
+    group = parser.add_argument_group(
+        "lossy links", "a simulated channel per link, applied on receive by every modem driver of the link (each "
+        "draws on its own; times in sim seconds; docs/intervehicle.md \"Lossy channels\")")
+    for link in CHANNEL_LINKS:
+        group.add_argument(f"--{link}-loss", type=_probability, default=0.0, metavar="P",
+                           help=f"probability (0..1) that a transmission on the {link} link (data or ack) is lost (default 0)")
+        group.add_argument(f"--{link}-delay", type=_delay, default=(0.0, 0.0), metavar="S[-S]",
+                           help=f"{link} delay in seconds, fixed or uniform in MIN-MAX, e.g. 1-3 (default 0)")
+        group.add_argument(f"--{link}-outage", type=_outage, default=None, metavar="S[/PERIOD]",
+                           help=f"the {link} link is dead for S seconds every PERIOD (default "
+                           f"{DEFAULT_OUTAGE_PERIOD_S:g}) seconds")
+    group.add_argument("--channel-seed", type=_seed, default=None, metavar="N",
+                       help="seed of the channels' draws, for a reproducible run (default: random)")
+
+
+def channel_settings(args: argparse.Namespace) -> dict[str, str]:
+    """Per link, its channel_model text from the flags ("" for a lossless link)."""
+    return {link: channel_text(getattr(args, f"{link}_loss"), getattr(args, f"{link}_delay"),
+                                            getattr(args, f"{link}_outage"), args.channel_seed)
+            for link in CHANNEL_LINKS}
+
+
+def channel_descriptions(settings: TrailSettings) -> dict[str, str]:
+    """Per link, its channel in words ("lossless" without one)."""
+    out = {}
+    for link in CHANNEL_LINKS:
+        model = settings.channel_model(link)
+        out[link] = "lossless" if model is None else describe(model)
+    return out
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -58,6 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help=f"{SCHEDULE_HELP} (default {DEFAULT_SCHEDULE['ivp']}; none with --usv-helm goby)")
     parser.add_argument("--east-duration", type=_positive_int, default=500, help="homework helm: east leg, s")
     parser.add_argument("--south-duration", type=_positive_int, default=200, help="homework helm: south leg, s")
+    add_channel_arguments(parser)
     add_run_arguments(parser)
     parser.add_argument("--listen", default="127.0.0.1", metavar="ADDRESS",
                         help="address the liaison pages listen on (default 127.0.0.1). RISK: another address lets "
@@ -70,6 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> TrailSettings:
+    channels = channel_settings(args)
     settings = TrailSettings(
         run_dir=run_dir,
         warp=args.warp,
@@ -80,6 +148,8 @@ def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> 
         socket_dir=socket_dir,
         east_duration=args.east_duration,
         south_duration=args.south_duration,
+        acomms_channel=channels["acomms"],
+        satellite_channel=channels["satellite"],
     )
     return with_free_ports(settings, args.auvs, prefer_course=True)
 
@@ -108,7 +178,7 @@ def _fmt(value: float | None) -> str:
 
 
 def report(result: TrailResult, operator: MissionRecord, n_auvs: int, links: LinkMonitor | None, sim_seconds: float,
-           out: Path, title: str) -> str:
+           out: Path, title: str, channels: dict[str, str] | None = None) -> str:
     """Analyse, write the CSVs and the picture, and return the summary text."""
     records = result.records
     operator = shifted(operator, result.t0)
@@ -124,7 +194,8 @@ def report(result: TrailResult, operator: MissionRecord, n_auvs: int, links: Lin
     write_trail_png(out / "trail.png", records, commands, recovers, trails, title)
     view = Counter(e.value for e in operator.events_named("node_status", "topside"))
     return summary_text(result, trails, commands, recovers, None if links is None else links.stats, sim_seconds,
-                        None if links is None else links.error, dict(view))
+                        None if links is None else links.error, dict(view), link_accounting(operator, n_auvs),
+                        channels)
 
 
 def liaison_urls_line(settings: TrailSettings, n_auvs: int) -> str:
@@ -156,6 +227,8 @@ def run_demo(args: argparse.Namespace) -> int:
     print(f"trail mission: topside, USV ({args.usv_helm} helm) and {n} AUVs; {settings.moosdb}, {settings.helm}, "
           f"warp {settings.warp}; MOOS ports {settings.moos_port_base}+id; logs in {run_dir / 'logs'}", flush=True)
     print(f"schedule: {schedule}", flush=True)
+    channels = channel_descriptions(settings)
+    print("channels: " + "; ".join(f"{link} {text}" for link, text in channels.items()), flush=True)
     mission = TrailMission(settings, n, report=_report, keep_going=args.keep_going)
     links = LinkMonitor(settings, n)
     mission.add_hook(links.poll)
@@ -197,7 +270,7 @@ def run_demo(args: argparse.Namespace) -> int:
     result, failure = run_mission(mission, body, run_dir, socket_dir, before_stop=close_workers_and_links)
     title = (f"Trail mission: USV ({args.usv_helm} helm) + {n} AUVs, {settings.helm} + {settings.moosdb}, "
              f"warp {settings.warp}, {sim_seconds:.0f} sim s")
-    print(report(result, operator_record, n, links, sim_seconds, out, title), flush=True)
+    print(report(result, operator_record, n, links, sim_seconds, out, title, channels), flush=True)
     real = time.monotonic() - started
     print(f"wrote {out / 'trail.png'}, {out / 'trail_tracks.csv'} and {out / 'trail_events.csv'} "
           f"({real:.0f} s real time)")

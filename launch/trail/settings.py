@@ -10,17 +10,26 @@ Two kinds of input, as in the Goby3 course's ``launch/trail/config``:
 Identities follow the course's ``common/vehicle.py`` and ``common/comms.py``: vehicle id 0 topside, 1 usv,
 2+i auv i; MOOS port 9000+id, simulator port 55000+id, liaison port 50000+id; satellite modem id+1, acomms
 modem id+1+256 under subnet mask 0xFF00; acomms TDMA slots alternating USV (258) and each AUV (259+i).
+
+``acomms_channel`` / ``satellite_channel`` (``TRAIL_ACOMMS_CHANNEL``, ``TRAIL_SATELLITE_CHANNEL``) impair a link:
+the text of our ``channel_model`` extension of its driver block (``loss: 0.2 delay_min: 1 delay_max: 3``), which
+every node of the link applies to what it receives (docs/intervehicle.md "Lossy channels"); empty: lossless.
 """
 
 from __future__ import annotations
 
 import ipaddress
+import math
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
 
+from google.protobuf import text_format
+
+from gateway.goby.acomms.channel import ChannelModel, check_channel_model
+from gateway.goby.acomms.errors import ModemConfigError
 from launch.config import EnvSettings, check_warp_and_origin, env_variables
 from launch.errors import MissionConfigError
 
@@ -49,7 +58,8 @@ _ENV = env_variables("TRAIL_", (
     "run_dir", "warp", "lat_origin", "lon_origin", "moos_port_base", "sim_port_base", "liaison_port_base",
     "satellite_port", "acomms_port", "moosdb", "helm", "usv_helm", "liaison_address", "link_address", "schedule",
     "socket_dir",
-    "east_duration", "south_duration"))
+    "east_duration", "south_duration", "acomms_channel", "satellite_channel"))
+CHANNEL_LINKS = ("satellite", "acomms")
 
 
 @dataclass(frozen=True)
@@ -78,9 +88,13 @@ class TrailSettings(EnvSettings):
     socket_dir: Path = Path("")  # where the brokers' IPC sockets go (default: run_dir); AF_UNIX paths are short
     east_duration: int = 500  # homework helm legs (goby3_course_helm.pb.cfg.in)
     south_duration: int = 200
+    acomms_channel: str = ""  # channel_model text for the acoustic link ("": lossless)
+    satellite_channel: str = ""  # ... for the satellite link
 
     def __post_init__(self) -> None:
         check_warp_and_origin(self.warp, self.lat_origin, self.lon_origin)
+        for link in CHANNEL_LINKS:
+            self.channel_model(link)  # a bad one is a MissionConfigError naming the variable and the field
         if self.usv_helm not in ("ivp", "goby"):
             raise MissionConfigError(f"TRAIL_USV_HELM must be ivp or goby, not {self.usv_helm!r}")
         try:
@@ -91,6 +105,20 @@ class TrailSettings(EnvSettings):
             port = getattr(self, name)
             if not 0 < port < 65536 - 256:
                 raise MissionConfigError(f"{name} {port} is not a TCP/UDP port with room for 256 vehicles")
+
+    def channel_model(self, link: str) -> ChannelModel | None:
+        """The checked channel model of ``link`` (satellite or acomms), or None for a lossless link."""
+        text = getattr(self, f"{link}_channel").strip()
+        if not text:
+            return None
+        model = ChannelModel()
+        var = _ENV[f"{link}_channel"]
+        try:
+            text_format.Parse(text, model)
+            check_channel_model(model)
+        except (text_format.ParseError, ModemConfigError) as exc:
+            raise MissionConfigError(f"{var}={text!r}: {exc}") from None
+        return model
 
     @property
     def sockets(self) -> Path:
@@ -178,6 +206,25 @@ class Vehicle:
         """Debug logs per platform, as the course's ``logs/topside``, ``logs/usv``, ``logs/auv/<i>``."""
         tail = Path("auv") / str(self.index) if self.kind == "auv" else Path(self.kind)
         return settings.run_dir / "logs" / tail
+
+
+def channel_text(loss: float = 0.0, delay: tuple[float, float] = (0.0, 0.0), outage: tuple[float, float] | None = None,
+                 seed: int | None = None) -> str:
+    """A link's ``channel_model`` text: ``loss`` (0..1), ``delay`` (min, max seconds), ``outage`` (duration, period
+    seconds), ``seed``; "" when nothing is impaired (a lossless link has no channel model at all)."""
+    parts = []
+    if loss:
+        parts.append(f"loss: {loss:g}")
+    if delay[1] > 0:
+        parts.append(f"delay_min: {delay[0]:g} delay_max: {delay[1]:g}")
+    if outage is not None and outage[0] > 0:
+        parts.append(f"outage_period: {outage[1]:g} outage_duration: {outage[0]:g}")
+    if parts and seed is not None:
+        parts.append(f"seed: {seed}")
+    text = " ".join(parts)
+    if any(not math.isfinite(x) for x in (loss, *delay, *(outage or ()))):
+        raise MissionConfigError(f"channel settings must be finite numbers: {text}")
+    return text
 
 
 def satellite_modem_id(vehicle_id: int) -> int:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import statistics
+from dataclasses import dataclass
 
 from launch.mission import ending_lines
 from launch.record import MissionRecord
@@ -15,6 +16,67 @@ from launch.trail.analysis import (
 )
 from launch.trail.links import LinkStats
 from launch.trail.mission import TrailResult
+from launch.trail.operator import RECOVER
+
+NO_SUBSCRIBERS = "EXPIRED_NO_SUBSCRIBERS"  # the reason the operator files (ExpireData.reason's name)
+
+
+@dataclass
+class LinkAccount:
+    """One link's commands as their publisher saw them: each sent command goes to ``recipients`` subscribers, and
+    each (command, recipient) must end acked or expired. ``no_subscribers`` counts EXPIRED_NO_SUBSCRIBERS notices
+    apart: every link of the publisher's broker reports one for a command none of its subscribers wants (the USV's
+    satellite link for each RECOVER), so they settle no delivery."""
+
+    name: str
+    recipients: int
+    sent: int = 0
+    acked: int = 0
+    expired: int = 0
+    no_subscribers: int = 0
+
+    @property
+    def deliveries(self) -> int:
+        return self.sent * self.recipients
+
+    @property
+    def unsettled(self) -> int:
+        """Deliveries neither acked nor expired yet (still within their ttl when the mission ended)."""
+        return self.deliveries - self.acked - self.expired
+
+
+def link_accounting(operator: MissionRecord, n_auvs: int) -> dict[str, LinkAccount]:
+    """Per link, the operator's commands sent, acked and expired (its ``command`` events): USV commands cross the
+    satellite link to the USV, RECOVER the acoustic link to every AUV."""
+    accounts = {"satellite": LinkAccount("satellite", 1), "acomms": LinkAccount("acomms", n_auvs)}
+    for event in operator.snapshot()[1]:
+        if event.source != "command":
+            continue
+        account = accounts["acomms" if event.value == RECOVER else "satellite"]
+        if event.name == "sent":
+            account.sent += 1
+        elif event.name == "ack":
+            account.acked += 1
+        elif event.name == "expire" and event.origin == NO_SUBSCRIBERS:
+            account.no_subscribers += 1
+        elif event.name == "expire":
+            account.expired += 1
+    return accounts
+
+
+def _accounting_lines(accounts: dict[str, LinkAccount], channels: dict[str, str]) -> list[str]:
+    lines = ["commands per link (acks and expiries as their publisher got them; sent = acked + expired + unsettled):"]
+    for account in accounts.values():
+        to = f"{account.recipients} recipient{'s' if account.recipients != 1 else ''}"
+        unsettled = account.unsettled
+        tail = "" if unsettled == 0 else (f", {unsettled} UNSETTLED (within their ttl at the end)" if unsettled > 0
+                                         else f", {-unsettled} more outcomes than deliveries")
+        if account.no_subscribers:
+            tail += (f" ({account.no_subscribers} {NO_SUBSCRIBERS} from a link of the publisher that carries no such "
+                     "command)")
+        lines.append(f"  {account.name} ({channels.get(account.name, 'lossless')}): {account.sent} sent x {to} = "
+                     f"{account.deliveries}: {account.acked} acked, {account.expired} expired{tail}")
+    return lines
 
 
 def _latest(record: MissionRecord, name: str, source: str = "moos") -> str:
@@ -44,8 +106,14 @@ def _timeline(items: list[tuple[float, str, str]], what: str) -> str:
 
 def summary_text(result: TrailResult, trails: list[TrailPerformance], commands: list[CommandOutcome],
                  recovers: list[RecoverOutcome], links: dict[str, LinkStats] | None, sim_seconds: float,
-                 link_error: str | None = None, topside_view: dict[str, int] | None = None) -> str:
+                 link_error: str | None = None, topside_view: dict[str, int] | None = None,
+                 accounts: dict[str, LinkAccount] | None = None, channels: dict[str, str] | None = None) -> str:
+    """The summary; ``channels`` (link -> its simulated channel, described) and ``accounts`` (per link, commands
+    sent / acked / expired) are printed when given."""
     lines = ["", "=== Trail mission summary (sim seconds; t=0 when every vehicle was under helm command) ==="]
+    if channels is not None:
+        described = "; ".join(f"{link} {channels.get(link, 'lossless')}" for link in ("satellite", "acomms"))
+        lines.append(f"channels (simulated on receive by each modem driver, docs/intervehicle.md): {described}")
     if topside_view is not None:
         seen = ", ".join(f"{name} x{count}" for name, count in sorted(topside_view.items())) or "nothing"
         lines.append(f"topside NodeStatus (the topside manager's republished nav, over satellite): {seen}")
@@ -81,6 +149,8 @@ def summary_text(result: TrailResult, trails: list[TrailPerformance], commands: 
                      f"{max(latencies):.1f} s over {len(latencies)} arrivals")
     if not commands:
         lines.append("  (none sent)")
+    if accounts is not None:
+        lines.extend(_accounting_lines(accounts, channels or {}))
     if recovers:
         lines.append("RECOVER (station 100,-100):")
     for r in recovers:

@@ -16,18 +16,28 @@ A datagram is remote input: before anything is acked or emitted, its fields are 
 numbers, no more frames or acked frames than a slot allows); a datagram that fails is dropped, counted in
 ``refused`` by cause and logged at a rate-limited cadence, and nothing a datagram makes the link code raise ends
 the link's thread. Only data from the link's ``peers`` (set by the link from its slot plan) is acked.
+
+A driver block with our ``channel_model`` extension impairs what this node receives (``gateway.goby.acomms.channel``:
+loss, delay, outages; checked at ``startup``): after a datagram is parsed and known not to be our own, the channel
+drops it (counted in ``channel.counters``, apart from ``refused``, and logged at a rate-limited cadence) or holds it
+until its delivery time; only then is it acked and emitted (the range checks come first: bad input is refused as
+such, never counted as a channel loss), so a delayed data frame is acked on
+delivery and the ack crosses the sender's channel in turn. The link delivers held datagrams from its thread's timer
+(``next_delivery`` / ``deliver_due``, on the link's clock), never by polling.
 """
 
 from __future__ import annotations
 
 import abc
 import logging
+import time
 from collections import Counter
 from collections.abc import Callable, Collection
 from typing import Generic, TypeVar
 
 from google.protobuf.message import DecodeError
 
+from gateway.goby.acomms.channel import Channel, channel_model_of, describe
 from gateway.goby.acomms.protobuf.driver_base_pb2 import DriverConfig
 from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
 from util.ratelimit import RateLimitedLog
@@ -67,13 +77,27 @@ class ModemDriver(abc.ABC):
         self.max_frames = 1  # frames (and acked frames) one transmission may carry on this link
         self.name = ""  # for log lines: which link this driver serves (default: "modem <id>")
         self.refusals = RateLimitedLog(log, REFUSED_LOG_PERIOD_S)  # what it refused; the link flushes held lines
+        self.clock: Callable[[], float] = time.time  # the link's (warped) clock: channel delays and outages
 
-    def expect(self, name: str, peers: Collection[int] | None, max_frames: int) -> None:
+    def expect(self, name: str, peers: Collection[int] | None, max_frames: int,
+               clock: Callable[[], float] | None = None) -> None:
         """What the link allows (call before ``startup``): the wire ids of its peers (None: any) and the most
-        frames a slot carries. Goby's driver acks and passes on anything; ours refuses the rest at the edge."""
+        frames a slot carries. Goby's driver acks and passes on anything; ours refuses the rest at the edge.
+        ``clock`` is the link's clock (warped seconds since the epoch)."""
         self.name = name
         self.peers = None if peers is None else frozenset(peers)
         self.max_frames = max(1, max_frames)
+        if clock is not None:
+            self.clock = clock
+
+    def next_delivery(self) -> float | None:
+        """When a received transmission held back (a simulated channel's delay) is next due, on ``clock``."""
+        return None
+
+    def deliver_due(self) -> None:
+        """Hand on (``signal_receive``) the held-back transmissions that are due; the link calls it at
+        ``next_delivery``. A driver that holds nothing back has nothing to do."""
+        return None
 
     @abc.abstractmethod
     def startup(self, cfg: DriverConfig) -> None:
@@ -109,6 +133,7 @@ class DatagramDriver(ModemDriver):
         self.received = 0  # datagrams received from others
         self.malformed = 0  # datagrams that are not a ModemTransmission
         self.refused: Counter[str] = Counter()  # datagrams dropped at the edge, by cause (malformed included)
+        self.channel: Channel[ModemTransmission] | None = None  # the channel_model extension, if any
 
     # -------------------------------------------------------------------------------------- transport
     @abc.abstractmethod
@@ -125,9 +150,14 @@ class DatagramDriver(ModemDriver):
 
     # -------------------------------------------------------------------------------------------- API
     def startup(self, cfg: DriverConfig) -> None:
+        """Subclasses call this first: a bad ``channel_model`` raises ``ModemConfigError`` before anything opens."""
+        model = channel_model_of(cfg)
         self.cfg = cfg
         self.modem_id = cfg.modem_id
         self.name = self.name or f"modem {cfg.modem_id}"
+        self.channel = None if model is None else Channel(model, cfg.modem_id)
+        if model is not None:
+            log.warning("%s: SIMULATED channel on receive (channel_model): %s", self.name, describe(model))
 
     def handle_initiate_transmission(self, msg: ModemTransmission) -> None:
         msg.src = self.modem_id
@@ -149,6 +179,18 @@ class DatagramDriver(ModemDriver):
                 self.refuse("failed", "handling it failed (%s: %s)", type(exc).__name__, exc, size=len(datagram))
                 log.debug("%s: the datagram that failed: %r", self.name, datagram[:256], exc_info=True)
         self.refusals.flush()
+
+    def next_delivery(self) -> float | None:
+        return None if self.channel is None else self.channel.next_delivery()
+
+    def deliver_due(self) -> None:
+        if self.channel is None:
+            return
+        for msg in self.channel.due(self.clock()):
+            try:
+                self._accept(msg)
+            except Exception as exc:  # noqa: BLE001 - what a datagram makes us raise must not end the link
+                self.refuse("failed", "handling it failed (%s: %s)", type(exc).__name__, exc, size=msg.ByteSize())
 
     def refuse(self, cause: str, why: str, *args: object, size: int) -> None:
         """Count a dropped datagram under ``cause`` and log it (rate-limited per cause)."""
@@ -192,6 +234,26 @@ class DatagramDriver(ModemDriver):
         if bad is not None:
             self.refuse(f"{bad[0]} out of range", "from modem %d: %s", msg.src, bad[1], size=len(datagram))
             return
+        if self.channel is not None:
+            fate, _ = self.channel.admit(msg, self.clock())
+            if fate != "deliver":
+                if fate != "delay":
+                    self._channel_drop(fate, msg)
+                return
+        self._accept(msg)
+
+    def _channel_drop(self, fate: str, msg: ModemTransmission) -> None:
+        assert self.channel is not None
+        c = self.channel.counters
+        why = {"lost": "lost (loss draw)", "outage": "lost in an outage window",
+               "overflow": f"dropped: {self.channel.held} transmissions already held back"}[fate]
+        kind = "ACK" if msg.type == ModemTransmission.ACK else "DATA" if msg.type == ModemTransmission.DATA else "other"
+        self.refusals.log(logging.INFO, ("channel", fate), "%s: simulated channel: %s transmission from modem %d %s "
+                          "[channel so far: %d received, %d lost, %d in outages, %d overflowed]", self.name, kind,
+                          msg.src, why, c.received, c.lost, c.outage, c.overflow)
+
+    def _accept(self, msg: ModemTransmission) -> None:
+        """A well-formed transmission from another modem that crossed the channel: ack it if asked, emit it."""
         self.received += 1
         if (msg.type == ModemTransmission.DATA and msg.ack_requested and msg.dest == self.modem_id
                 and (self.peers is None or msg.src in self.peers)):

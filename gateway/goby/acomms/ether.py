@@ -1,7 +1,8 @@
 """The in-process "ether": one object per simulated link, every attached driver hears every datagram.
 
-For tests and single-process simulations that need no multicast (Goby's UDP multicast driver has no loss or delay
-model either, so the observable behaviour is the same). Thread-safe: the drivers of several brokers or links
+For tests and single-process simulations that need no multicast. The ether itself loses nothing, as Goby's UDP
+multicast driver; a driver block with our ``channel_model`` extension impairs what each attached driver receives
+(``gateway.goby.acomms.channel``, applied by :class:`DatagramDriver`), each driver drawing on its own. Thread-safe: the drivers of several brokers or links
 may run on different threads. Each driver's inbox comes with an eventfd that a datagram makes readable, so the
 link's thread waits on it as on a socket.
 """

@@ -8,7 +8,9 @@ deliver only datagrams sent to the group, never unicast to the port; joining on 
 sends on 127.0.0.1 (``IP_MULTICAST_IF``), which needs no multicast route and never leaves the machine; 0.0.0.0
 joins on the default interface, as Goby does; any other address joins on the interface that has it. Datagrams
 from a source outside ``peer_address`` (our ``udp_peers`` extension; loopback listen: outside 127.0.0.0/8) are
-dropped, counted and logged at a rate-limited cadence.
+dropped, counted and logged at a rate-limited cadence. Our ``channel_model`` extension of the driver block adds a
+simulated channel's loss, delay and outages on receive (:class:`DatagramDriver`, ``gateway.goby.acomms.channel``)
+where Linux netem cannot be used (docs/intervehicle.md "Lossy channels").
 """
 
 from __future__ import annotations

@@ -4,7 +4,8 @@ It owns the link's DynamicBuffer, its TDMA MAC and its modem driver, and talks t
 :class:`LinkOutputs` callbacks (the broker's intervehicle thread publishes them on interprocess). Every method runs
 on one thread (in the broker, its intervehicle thread). Goby runs the link in a 10 Hz loop; here the work is split
 so that a thread waits for it instead: ``receive()`` when the driver's ``fileno()`` is readable, ``run_due()`` at
-``next_deadline()`` (the next slot start or ttl expiry), ``flush_logs()`` once held-back log lines are due.
+``next_deadline()`` (the next slot start, ttl expiry or delivery of a transmission a simulated channel held back),
+``flush_logs()`` once held-back log lines are due.
 ``loop()`` does all of it, for a link driven by hand (tests, benchmarks).
 
 - ``buffer_message(stm)``: a local publication; buffered for every remote subscriber of its (group, DCCL id) in this
@@ -140,7 +141,7 @@ class Link:
         self.drops = RateLimitedLog(log, DROP_LOG_PERIOD_S)
         peers = {self.within_subnet(src) for src in self._slot_srcs if self.in_subnet(src) and src != self.modem_id}
         driver.expect(self.name, sorted(peers) if self._slot_srcs else None,
-                      max((slot.max_num_frames for slot in cfg.mac.slot), default=1))
+                      max((slot.max_num_frames for slot in cfg.mac.slot), default=1), clock=now)
         mac_cfg = type(cfg.mac)()
         mac_cfg.CopyFrom(cfg.mac)
         mac_cfg.modem_id = cfg.modem_id
@@ -191,10 +192,12 @@ class Link:
             self.driver.shutdown()
 
     def loop(self) -> None:
-        """Expire, let the driver read, let the MAC start a slot, flush due log lines (Goby's 10 Hz loop)."""
+        """Expire, let the driver read (and deliver what a simulated channel held back), let the MAC start a slot,
+        flush due log lines (Goby's 10 Hz loop)."""
         now = self.now()
         self._expire_due(now)
         self.driver.do_work()
+        self.driver.deliver_due()
         self.mac.do_work(now)
         self.flush_logs()
 
@@ -203,14 +206,18 @@ class Link:
         self.driver.do_work()
 
     def run_due(self) -> None:
-        """The timed part of Goby's loop: expire values past their ttl, start the slot whose time has come."""
+        """The timed part of Goby's loop: expire values past their ttl, deliver the received transmissions a
+        simulated channel held back until now, start the slot whose time has come."""
         now = self.now()
         self._expire_due(now)
+        self.driver.deliver_due()
         self.mac.do_work(now)
 
     def next_deadline(self) -> float | None:
-        """When ``run_due`` next has work (warped s since the epoch): the next slot start or ttl expiry."""
-        times = [t for t in (self.mac.next_slot_time(self.now()), self.buffer.next_expiry()) if t is not None]
+        """When ``run_due`` next has work (warped s since the epoch): the next slot start, ttl expiry or delayed
+        delivery."""
+        times = [t for t in (self.mac.next_slot_time(self.now()), self.buffer.next_expiry(),
+                             self.driver.next_delivery()) if t is not None]
         return min(times, default=None)
 
     @property

@@ -27,15 +27,16 @@ from gateway.goby.protobuf import interprocess_config_pb2 as gateway_dot_goby_do
 from gateway.goby.intervehicle.protobuf import intervehicle_pb2 as gateway_dot_goby_dot_intervehicle_dot_protobuf_dot_intervehicle__pb2
 from gateway.goby.acomms.protobuf import udp_multicast_driver_pb2 as gateway_dot_goby_dot_acomms_dot_protobuf_dot_udp__multicast__driver__pb2
 from gateway.goby.acomms.protobuf import udp_peers_pb2 as gateway_dot_goby_dot_acomms_dot_protobuf_dot_udp__peers__pb2
+from gateway.goby.acomms.protobuf import channel_model_pb2 as gateway_dot_goby_dot_acomms_dot_protobuf_dot_channel__model__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n/gateway/goby/portal/protobuf/gobyd_config.proto\x12\x19goby.apps.zeromq.protobuf\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\x1a\x35gateway/goby/intervehicle/protobuf/intervehicle.proto\x1a\x37gateway/goby/acomms/protobuf/udp_multicast_driver.proto\x1a,gateway/goby/acomms/protobuf/udp_peers.proto\"\xae\x02\n\x10GobyDaemonConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x1a\n\x0erouter_threads\x18\x02 \x01(\x05:\x02\x31\x30\x12\x44\n\x0cinterprocess\x18\x03 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12I\n\x0cintervehicle\x18\x04 \x01(\x0b\x32\x33.goby.middleware.intervehicle.protobuf.PortalConfig\x12;\n\x04hold\x18\n \x01(\x0b\x32-.goby.zeromq.protobuf.InterProcessManagerHold')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n/gateway/goby/portal/protobuf/gobyd_config.proto\x12\x19goby.apps.zeromq.protobuf\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\x1a\x35gateway/goby/intervehicle/protobuf/intervehicle.proto\x1a\x37gateway/goby/acomms/protobuf/udp_multicast_driver.proto\x1a,gateway/goby/acomms/protobuf/udp_peers.proto\x1a\x30gateway/goby/acomms/protobuf/channel_model.proto\"\xae\x02\n\x10GobyDaemonConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x1a\n\x0erouter_threads\x18\x02 \x01(\x05:\x02\x31\x30\x12\x44\n\x0cinterprocess\x18\x03 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12I\n\x0cintervehicle\x18\x04 \x01(\x0b\x32\x33.goby.middleware.intervehicle.protobuf.PortalConfig\x12;\n\x04hold\x18\n \x01(\x0b\x32-.goby.zeromq.protobuf.InterProcessManagerHold')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'gateway.goby.portal.protobuf.gobyd_config_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_GOBYDAEMONCONFIG']._serialized_start=326
-  _globals['_GOBYDAEMONCONFIG']._serialized_end=628
+  _globals['_GOBYDAEMONCONFIG']._serialized_start=376
+  _globals['_GOBYDAEMONCONFIG']._serialized_end=678
 # @@protoc_insertion_point(module_scope)
