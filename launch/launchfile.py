@@ -2,7 +2,8 @@
 
 The format follows goby3's ``scripts/goby_launch``: ``#`` starts a comment anywhere on a line, blank
 lines are dropped, and a leading ``[...]`` holds directives separated by any of ``;``, ``,`` or space:
-``kill=SIGTERM|SIGINT|SIGKILL|goby_terminate``, ``env=NAME=value`` (repeatable) and ``name=...``.
+``kill=SIGTERM|SIGINT|SIGKILL|goby_terminate``, ``env=NAME=value`` (repeatable) and ``name=...``.  Without
+``kill=`` the launcher chooses, as goby_launch: goby_terminate when the file has exactly one broker line, else SIGTERM.
 The command itself is left untouched: it is run by bash, which does its own expansion and process
 substitution. Parsing is pure: no process is started and no environment is read here.
 """
@@ -23,7 +24,8 @@ KILL_SIGNALS = {
     "SIGTERM": signal.SIGTERM,
     "SIGINT": signal.SIGINT,
     "SIGKILL": signal.SIGKILL,
-    # goby_terminate asks a Goby app over interprocess to quit; our apps quit cleanly on SIGTERM.
+    # goby_terminate asks a Goby app over interprocess to quit (launch/process_group.py runs goby-terminate);
+    # SIGTERM is what follows when it does not answer or does not quit.
     "goby_terminate": signal.SIGTERM,
 }
 
@@ -41,6 +43,7 @@ class LaunchEntry:
     env: tuple[tuple[str, str], ...] = ()
     kill: str = "SIGTERM"
     name: str | None = None
+    kill_given: bool = False  # kill= was written: the launcher's default (goby_terminate or SIGTERM) does not apply
     line_number: int = 0
     source: str = "<string>"
 
@@ -140,6 +143,7 @@ def parse_lines(lines: Iterable[str], source: str = "<string>") -> LaunchFile:
                 env=tuple(env),
                 kill=kill or "SIGTERM",
                 name=name,
+                kill_given=kill is not None,
                 line_number=number,
                 source=source,
             )

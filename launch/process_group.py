@@ -2,8 +2,11 @@
 
 Each entry runs as ``bash -c "exec <command>"`` in its own session (so a terminal's Ctrl-C reaches only
 the launcher, which then stops the children in order), with stdout and stderr in one log file per
-process. Shutdown sends the entry's kill signal to the process group, waits, then escalates to SIGKILL,
-like goby_launch's ``-k``.
+process. Shutdown follows goby_launch: a line's ``kill=`` method, by default ``goby_terminate`` when the launch file
+has exactly one broker line (the broker itself gets SIGTERM) and SIGTERM otherwise.  ``goby_terminate`` runs
+``goby-terminate --target_pid PID`` with the broker's ``interprocess`` block (read at start-up from the broker line run
+with ``--app 'debug_cfg: true'``, as goby_launch does) and waits up to ``terminate_timeout_s`` (``-m``); a process that
+does not quit then gets SIGTERM.  A signal is followed by SIGKILL after ``kill_timeout_s`` (``-k``).
 """
 
 from __future__ import annotations
@@ -11,6 +14,8 @@ from __future__ import annotations
 import logging
 import os
 import re
+import signal
+import subprocess
 import sys
 import threading
 import time
@@ -19,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from launch.errors import LaunchError, ProcessDiedError
-from launch.launchfile import LaunchEntry, expand_vars
+from launch.launchfile import KILL_SIGNALS, LaunchEntry, expand_vars
 from util.process import ChildProcess, ProcessError
 from util.reactor import Reactor
 
@@ -31,6 +36,23 @@ POLL_PERIOD_S = 0.1
 # The line a launcher prints per launch (``_report_launched``): pid and name, for tools reading its output.
 LAUNCHED_LINE = re.compile(r"^Launched \((\d+)\) (\S+):", re.M)
 BROKER_PROGRAMS = frozenset({"goby-broker", "gobyd"})
+TERMINATE_COMMAND = (sys.executable, "-m", "gateway.apps.goby_terminate")
+BROKER_CONFIG_TIMEOUT_S = 30.0  # for the broker line's ``--app 'debug_cfg: true'`` run
+_INTERPROCESS_BLOCK = re.compile(r"^interprocess\s*\{", re.M)
+
+
+def interprocess_block(config_text: str) -> str | None:
+    """The inside of the top-level ``interprocess { ... }`` block of a printed configuration, on one line."""
+    match = _INTERPROCESS_BLOCK.search(config_text)
+    if match is None:
+        return None
+    depth, start = 1, match.end()
+    for index in range(start, len(config_text)):
+        char = config_text[index]
+        depth += {"{": 1, "}": -1}.get(char, 0)
+        if depth == 0:
+            return " ".join(config_text[start:index].split())
+    return None
 
 
 def _print(line: str) -> None:
@@ -103,6 +125,7 @@ class ProcessGroup:
         report: Reporter = _print,
         on_wait: Callable[[], None] | None = None,
         preamble: str = "",
+        terminate_timeout_s: float = 10.0,
     ) -> None:
         if not entries:
             raise LaunchError("nothing to launch: the launch file has no commands")
@@ -120,6 +143,9 @@ class ProcessGroup:
         self.on_wait = on_wait
         # Shell run before each command (goby_launch sources a preseed.goby found next to the launch file).
         self.preamble = preamble
+        self.terminate_timeout_s = terminate_timeout_s
+        # The broker's interprocess block for goby-terminate; None: goby_terminate is not used (SIGTERM instead)
+        self.terminate_interprocess: str | None = None
         self.processes: list[ManagedProcess] = []
         self.stop_event = threading.Event()
         self._named_once = False
@@ -168,6 +194,7 @@ class ProcessGroup:
 
         On a death during start-up, stops what was started and raises ProcessDiedError.
         """
+        self.terminate_interprocess = self._broker_interprocess()
         try:
             for entry in self.entries:
                 if self.stop_event.is_set():
@@ -190,6 +217,64 @@ class ProcessGroup:
             remaining = deadline - time.monotonic()
             if remaining <= 0 or self.stop_event.wait(min(POLL_PERIOD_S, remaining)):
                 return
+
+    def _broker_interprocess(self) -> str | None:
+        """The interprocess block of the one broker line, for goby-terminate (None: use SIGTERM), as goby_launch."""
+        brokers = [e for e in self.entries
+                   if os.path.basename(expand_vars(e.binary, e.environment(self.base_env))) in BROKER_PROGRAMS]
+        if len(brokers) != 1:
+            self.report(f"Note: {'no line' if not brokers else 'more than one line'} launching a broker - will use "
+                        "SIGTERM instead of goby_terminate to stop processes (unless marked with [kill=...])")
+            return None
+        entry = brokers[0]
+        script = f"{entry.command} --app 'debug_cfg: true'"
+        if not _ASSIGNMENT.match(entry.command):
+            script = f"exec {script}"
+        if self.preamble:
+            script = f"{self.preamble}\n{script}"
+        try:
+            run = subprocess.run(["/bin/bash", "-c", script], env=entry.environment(self.base_env), cwd=self.cwd,
+                                 stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                                 timeout=BROKER_CONFIG_TIMEOUT_S, check=False)
+            block = interprocess_block(run.stdout) if run.returncode == 0 else None
+        except (OSError, subprocess.TimeoutExpired) as exc:
+            log.warning("cannot read the broker's configuration: %s", exc)
+            block = None
+        if block is None:
+            self.report(f"Note: cannot read the interprocess configuration of {entry.command!r} - will use SIGTERM "
+                        "instead of goby_terminate to stop processes")
+        return block
+
+    def kill_method(self, process: ManagedProcess) -> str:
+        """How ``process`` is stopped: its ``kill=``, else goby_terminate (one broker line; not the broker) or SIGTERM."""
+        entry = process.entry
+        method = entry.kill if entry.kill_given else "goby_terminate"
+        if method == "goby_terminate" and (self.terminate_interprocess is None or entry.binary in BROKER_PROGRAMS):
+            return "SIGTERM"
+        return method
+
+    def _terminate(self, processes: Sequence[ManagedProcess]) -> list[ManagedProcess]:
+        """Run goby-terminate for ``processes`` and wait; returns those still running afterwards."""
+        assert self.terminate_interprocess is not None
+        args = [*TERMINATE_COMMAND, "--response_timeout", f"{self.terminate_timeout_s:g}",
+                "--interprocess", self.terminate_interprocess]
+        for process in processes:
+            process.child.stop_requested = True
+            args += ["--target_pid", str(process.pid)]
+        tool = ChildProcess(args, self.log_dir / "goby-terminate.log", name="goby-terminate", env=self.base_env,
+                            cwd=self.cwd)
+        try:
+            tool.start()
+        except ProcessError as exc:
+            log.warning("cannot run goby-terminate: %s", exc)
+            return [p for p in processes if p.running]
+        if tool.wait(self.terminate_timeout_s + BROKER_CONFIG_TIMEOUT_S) is None:
+            log.warning("goby-terminate did not end; stopping it")
+        tool.stop(grace=2.0)
+        for process in processes:
+            if process.child.wait(1.0) is not None:  # goby-terminate saw it end: reap it and close its log
+                process.child.stop()
+        return [p for p in processes if p.running]
 
     # -- supervision ----------------------------------------------------------------------------
 
@@ -321,19 +406,42 @@ class ProcessGroup:
     # -- shutdown -------------------------------------------------------------------------------
 
     def _stop_all(self, processes: Sequence[ManagedProcess]) -> None:
-        """Signal each with its kill signal at once, then give them ``kill_timeout_s`` together before SIGKILL."""
-        for process in processes:
+        """goby-terminate those stopped that way (one run for all), then signal the rest at once and give them
+        ``kill_timeout_s`` together before SIGKILL."""
+        by_terminate = [p for p in processes if self.kill_method(p) == "goby_terminate"]
+        left = self._terminate(by_terminate) if by_terminate else []
+        for process in left:
+            self.report(f"=== WARNING ===: {process.name} ({process.pid}) did not respond to goby_terminate, "
+                        "sending SIGTERM")
+        signalled = [p for p in processes if p not in by_terminate or p in left]
+        for process in signalled:
             process.child.stop_requested = True
-            process.child.send_signal(process.entry.kill_signal)
+            process.child.send_signal(self._signal_of(process))
         deadline = time.monotonic() + self.kill_timeout_s
-        for process in processes:
+        for process in signalled:
             self._stop_one(process, max(0.0, deadline - time.monotonic()))
 
+    def _signal_of(self, process: ManagedProcess) -> signal.Signals:
+        method = self.kill_method(process)
+        return signal.SIGTERM if method == "goby_terminate" else KILL_SIGNALS[method]
+
     def _stop_one(self, process: ManagedProcess, grace: float) -> None:
-        process.child.stop(grace=grace, sig=process.entry.kill_signal)
+        sig = self._signal_of(process)
+        process.child.stop(grace=grace, sig=sig)
         if process.child.killed:
             self.report(f"WARNING: {process.name} ({process.pid}) did not respond to "
-                        f"{process.entry.kill_signal.name} after {self.kill_timeout_s:g} s, sending SIGKILL")
+                        f"{sig.name} after {self.kill_timeout_s:g} s, sending SIGKILL")
+
+    def _stop_in_turn(self, process: ManagedProcess) -> None:
+        """goby_launch's do_killone: goby_terminate first if that is the method, then the signal."""
+        if self.kill_method(process) == "goby_terminate":
+            self.report(f"goby_terminate: {process.pid} (was {process.name})")
+            if not self._terminate([process]):
+                self.report(f"goby_terminate: {process.pid} (was {process.name}) .... success")
+                return
+            self.report(f"=== WARNING ===: Process {process.pid} did not respond to goby_terminate, sending SIGTERM")
+        self.report(f"{self._signal_of(process).name}: {process.pid} (was {process.name})")
+        self._stop_one(process, self.kill_timeout_s)
 
     def stop(self) -> None:
         """Stop every running process (reverse launch order, or all at once if parallel_stop)."""
@@ -353,8 +461,7 @@ class ProcessGroup:
                 self._stop_all(wave)
         else:
             for process in live:
-                self.report(f"{process.entry.kill_signal.name}: {process.pid} (was {process.name})")
-                self._stop_one(process, self.kill_timeout_s)
+                self._stop_in_turn(process)
         for process in live:
             verdict = "success" if process.exited_cleanly else f"exit status {process.returncode}"
             log.info("%s stopped: %s", process.name, verdict)

@@ -1,8 +1,9 @@
 """``goby-launch``: run the processes of a goby_launch launch file, like goby3's ``goby_launch -r``.
 
 Processes start in order with a delay (``-d`` ms), each with its own log file (``-L`` directory);
-the launcher reports every few seconds which are up. Ctrl-C or SIGTERM stops them in reverse order
-(the line's kill signal, then SIGKILL after ``-k`` seconds). If one dies, the launcher names it, shows
+the launcher reports every few seconds which are up. Ctrl-C or SIGTERM stops them in reverse order: as
+goby_launch, with goby-terminate by default when the file has exactly one broker line (SIGTERM if an app has not
+quit after ``-m`` seconds), else with the line's ``kill=`` signal (default SIGTERM); SIGKILL after ``-k`` seconds. If one dies, the launcher names it, shows
 the tail of its log, stops the rest and exits non-zero; with ``--respawn N`` (or ``GOBY_LAUNCH_RESPAWN=N``,
 which nested launchers inherit) it starts a dead process again, up to N times each, before giving up.
 """
@@ -56,7 +57,7 @@ def build_parser() -> argparse.ArgumentParser:
     mode.add_argument("-x", dest="mode", action="store_const", const="xterm", help="not supported here")
     parser.add_argument("-d", dest="delay_ms", type=float, default=10.0, help="delay between launches, ms (10)")
     parser.add_argument("-k", dest="kill_s", type=float, default=10.0, help="SIGKILL after this many s (10)")
-    parser.add_argument("-m", dest="terminate_s", type=float, default=10.0, help="accepted for compatibility")
+    parser.add_argument("-m", dest="terminate_s", type=float, default=10.0, help="SIGTERM after goby_terminate for this many s (10)")
     parser.add_argument("-p", dest="platform", default=None, help="platform name (default: launch file stem)")
     parser.add_argument("-P", dest="parallel", action="store_true", help="stop all processes at once")
     parser.add_argument("-L", dest="log_dir", default=None, help="log directory (default /tmp/goby_launch_<platform>_<time>)")
@@ -110,6 +111,7 @@ def main(argv: list[str] | None = None) -> int:
         startup_check_s=args.startup_check,
         base_env=env,
         parallel_stop=args.parallel,
+        terminate_timeout_s=args.terminate_s,
     )
     preseed = Path(args.launchfile).resolve().parent / PRESEED
     preamble = f"source {shlex.quote(str(preseed))} || exit 1" if preseed.is_file() else ""

@@ -1,5 +1,10 @@
 """Applications in Goby's shape: the main thread is itself a :class:`SimpleThread`; a multi-thread application
-launches and joins further threads, each running its own poll loop on its own Python thread."""
+launches and joins further threads, each running its own poll loop on its own Python thread.
+
+With an ``interprocess`` configuration every application answers goby-coroner's health requests
+(``gateway.goby.portal.health``) and quits on a goby-terminate request naming it
+(``gateway.goby.portal.terminate``), as Goby3's applications do (docs/health.md).
+"""
 
 from __future__ import annotations
 
@@ -9,10 +14,13 @@ from typing import Any
 
 from google.protobuf.message import Message
 
-from gateway.goby.portal.config import interprocess_config_of
+from gateway.goby.portal.config import app_config_of, interprocess_config_of
 from gateway.goby.portal.context import start_on_thread
 from gateway.goby.portal.errors import ThreadError
 from gateway.goby.portal.group import Group
+from gateway.goby.portal.health import ThreadHealthCollector, answer_at_once
+from gateway.goby.portal.protobuf.coroner_pb2 import HEALTH__OK, ThreadHealth
+from gateway.goby.portal.terminate import subscribe_terminate
 from gateway.goby.portal.thread import SimpleThread
 
 log = logging.getLogger(__name__)
@@ -32,6 +40,8 @@ class _Application(SimpleThread):
             self.interprocess()
             if isinstance(cfg, Message):  # Goby's start-up announcement (PROTOBUF; held until the broker releases)
                 self.interprocess().publish(CONFIGURATION_GROUP, cfg)
+            subscribe_terminate(self, self.app_name, self.quit)
+            self._subscribe_health()
 
     @property
     def return_code(self) -> int:
@@ -46,6 +56,15 @@ class _Application(SimpleThread):
     def app_name(self) -> str:
         return self.context.application
 
+    def health(self, health: ThreadHealth) -> None:
+        """The main thread's health: named after the application, ``HEALTH__OK`` (Goby's application default)."""
+        health.name = self.app_name()
+        health.state = HEALTH__OK
+
+    def _subscribe_health(self) -> None:
+        """Answer goby-coroner's requests (main thread)."""
+        answer_at_once(self, self.app_name)
+
     def _after_initialize(self) -> None:
         if self._transports.has_interprocess:
             self.interprocess().ready()
@@ -59,9 +78,19 @@ class MultiThreadApplication(_Application):
     """The main thread plus threads started with :meth:`launch_thread`."""
 
     def __init__(self, cfg: Any, loop_frequency_hz: float = 0.0) -> None:
-        super().__init__(cfg, loop_frequency_hz)
         self._threads: list[tuple[SimpleThread, threading.Thread]] = []
         self._threads_lock = threading.Lock()
+        self._next_uid = 0  # Goby's thread uid: launch order, from 0
+        super().__init__(cfg, loop_frequency_hz)
+
+    def _subscribe_health(self) -> None:
+        """Collect every launched thread's answer, unless ``app.health_cfg.run_health_monitor_thread`` is false:
+        then, as Goby without its HealthMonitorThread, the application does not answer over interprocess."""
+        app_cfg = app_config_of(self.cfg())
+        if app_cfg is not None and not app_cfg.health_cfg.run_health_monitor_thread:
+            log.debug("health_cfg.run_health_monitor_thread is false: not answering health requests")
+            return
+        ThreadHealthCollector(self, self.app_name, self.threads)
 
     def launch_thread(self, thread_class: type[SimpleThread], *args: Any, **kwargs: Any) -> SimpleThread:
         """Start ``thread_class(*args, **kwargs)`` (default args: ``(self.cfg(),)``) on a new Python thread.
@@ -72,6 +101,13 @@ class MultiThreadApplication(_Application):
         """
         if not args and not kwargs:
             args = (self.cfg(),)
+        uid, self._next_uid = self._next_uid, self._next_uid + 1
+
+        def build() -> SimpleThread:
+            instance = thread_class(*args, **kwargs)
+            name = f"{thread_class.__module__}.{thread_class.__qualname__}"
+            instance.set_identity(name if instance.index < 0 else f"{name}/{instance.index}", uid)
+            return instance
 
         def run(instance: SimpleThread) -> None:
             try:
@@ -83,7 +119,7 @@ class MultiThreadApplication(_Application):
                 instance.close()
 
         try:
-            instance, pythread = start_on_thread(self.context, lambda: thread_class(*args, **kwargs), run,
+            instance, pythread = start_on_thread(self.context, build, run,
                                                  thread_class.__qualname__)
         except BaseException as exc:
             raise ThreadError(f"{thread_class.__qualname__} failed to start: {exc}") from exc

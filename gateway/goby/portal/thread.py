@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import math
+import threading
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -16,6 +17,7 @@ from gateway.goby.portal.config import app_name_of, interprocess_config_of
 from gateway.goby.portal.context import ProcessContext, current_context
 from gateway.goby.portal.interprocess import InterProcessPortal
 from gateway.goby.portal.interthread import InterThreadTransporter
+from gateway.goby.portal.protobuf.coroner_pb2 import HEALTH__OK, ThreadHealth
 from gateway.goby.portal.transports import ThreadTransports
 from util.reactor import Reactor, Timer
 
@@ -48,6 +50,10 @@ class SimpleThread:
         self._loop_timer: Timer | None = None
         self._loop_error: Exception | None = None
         self._intervehicle: Any = None
+        # Goby's Thread identity in health answers: the Linux thread id, a name and (launched threads) a uid
+        self._thread_id = threading.get_native_id()
+        self._thread_name = str(self._thread_id)
+        self._uid = -1
 
     # ------------------------------------------------------------------------------------ accessors
     def cfg(self) -> Any:
@@ -105,6 +111,41 @@ class SimpleThread:
 
     def finalize(self) -> None:
         """Called on the thread after the last ``loop()``, before its transports close."""
+
+    def health(self, health: ThreadHealth) -> None:
+        """Fill this thread's state when goby-coroner asks (Goby's ``Thread::health``); runs on this thread.
+
+        ``health`` already carries the name, thread id and uid; the default says ``HEALTH__OK``.  Override to
+        report ``HEALTH__DEGRADED``/``HEALTH__FAILED`` with an ``error`` and ``error_message``.
+        """
+        health.state = HEALTH__OK
+
+    # ------------------------------------------------------------------------------------- health
+    @property
+    def thread_name(self) -> str:
+        """The name health answers give this thread (Goby: the thread id, or the launched class's name)."""
+        return self._thread_name
+
+    @property
+    def uid(self) -> int:
+        """The launch number a multi-thread application gave this thread (-1: not launched)."""
+        return self._uid
+
+    def set_identity(self, name: str, uid: int) -> None:
+        """Set the name and uid health answers report (the launching application calls it, as Goby's launcher)."""
+        self._thread_name = name
+        self._uid = uid
+
+    def thread_health(self) -> ThreadHealth:
+        """This thread's ``ThreadHealth`` (Goby's ``Thread::thread_health``): identity, then :meth:`health`.
+
+        Call it on this thread: :meth:`health` reads the thread's own state.
+        """
+        answer = ThreadHealth(name=self._thread_name, thread_id=self._thread_id)
+        if self._uid >= 0:
+            answer.uid = self._uid
+        self.health(answer)
+        return answer
 
     # ------------------------------------------------------------------------------ cross-thread API
     def call_soon(self, fn: Callable[[], Any]) -> None:
