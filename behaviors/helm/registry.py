@@ -13,20 +13,33 @@ only when a ``.bhv`` file names its type, through the project's one loader (``ut
 
 from __future__ import annotations
 
+import importlib
+
 from util.extensions import ExtensionPoint, load_extension
 
 from .behavior import Behavior
-from .bhv_constant import ConstantDepthBehavior, ConstantHeadingBehavior, ConstantSpeedBehavior
-from .bhv_loiter import LoiterBehavior
-from .bhv_stationkeep import StationKeepBehavior
-from .bhv_trail import TrailBehavior
-from .bhv_waypoint import WaypointBehavior
 
-BEHAVIOR_TYPES: dict[str, type[Behavior]] = {
-    cls.TYPE: cls
-    for cls in (WaypointBehavior, LoiterBehavior, ConstantSpeedBehavior, ConstantHeadingBehavior,
-                ConstantDepthBehavior, StationKeepBehavior, TrailBehavior)
+#: The built-in types: module (in this package) and class, imported when a ``.bhv`` file first names the type (a
+#: helm loads only what its mission uses: BHV_Trail's CPA tables and contact code stay out of a loitering USV's).
+BEHAVIOR_TYPES: dict[str, tuple[str, str]] = {
+    "BHV_Waypoint": ("bhv_waypoint", "WaypointBehavior"),
+    "BHV_Loiter": ("bhv_loiter", "LoiterBehavior"),
+    "BHV_ConstantSpeed": ("bhv_constant", "ConstantSpeedBehavior"),
+    "BHV_ConstantHeading": ("bhv_constant", "ConstantHeadingBehavior"),
+    "BHV_ConstantDepth": ("bhv_constant", "ConstantDepthBehavior"),
+    "BHV_StationKeep": ("bhv_stationkeep", "StationKeepBehavior"),
+    "BHV_Trail": ("bhv_trail", "TrailBehavior"),
 }
+
+
+def builtin_class(type_name: str) -> type[Behavior] | None:
+    """The built-in class for ``type_name`` (imported now), or None."""
+    where = BEHAVIOR_TYPES.get(type_name)
+    if where is None:
+        return None
+    module = importlib.import_module(f"{__package__}.{where[0]}")
+    cls: type[Behavior] = getattr(module, where[1])
+    return cls
 
 BEHAVIOR_POINT = ExtensionPoint(group="ivp_helm.behaviors", what="helm behaviour", source="a .bhv file",
                                 entry_points_only=True)
@@ -38,7 +51,7 @@ def behavior_class(type_name: str) -> type[Behavior] | None:
     Raises ExtensionError when an installed entry point of that name cannot be imported, does not name a
     :class:`Behavior` subclass, or names one whose ``TYPE`` is another type.
     """
-    builtin = BEHAVIOR_TYPES.get(type_name)
+    builtin = builtin_class(type_name)
     if builtin is not None:
         return builtin
     if BEHAVIOR_POINT.entry_point(type_name) is None:
