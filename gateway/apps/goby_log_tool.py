@@ -6,9 +6,15 @@
 ``--group_regex``, ``--exclude_type_regex``, ``--exclude_group_regex``, ``--load_shared_library`` (Python modules
 whose protobuf types decode entries the log does not describe).
 
+HDF5 (Goby's layout, :mod:`gateway.goby.log.hdf5_export`; ``--write_hdf5_zero_length_dim``,
+``--hdf5_chunk_length``, ``--hdf5_compression_level``) and MCAP (:mod:`gateway.goby.log.mcap_export`, for
+Foxglove) need the ``log`` extra (h5py, mcap); without it they exit 1 saying so.  MCAP may go to stdout (``-``),
+HDF5 may not.
+
 Each span of the input that is not a whole valid entry is reported on stderr with its byte offset, and the
 reading goes on at the next ``GBY3``.  Exit codes: 0 everything was read; 3 some bytes were skipped (the output
-holds every readable entry); 1 the input cannot be read or the format is not available; 2 a bad command line.
+holds every readable entry); 1 the input cannot be read, the output cannot be written or the format's library is
+missing; 2 a bad command line.
 """
 
 from __future__ import annotations
@@ -16,14 +22,17 @@ from __future__ import annotations
 import logging
 import re
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
 
 from google.protobuf import message as pb_message
 
+from gateway.goby.log.entry import LogEntry
 from gateway.goby.log.errors import LogFormatError
+from gateway.goby.log.hdf5_export import Hdf5Unavailable, export_hdf5, import_h5py  # h5py: imported when used
+from gateway.goby.log.mcap_export import McapExporter, McapUnavailable, import_mcap_writer  # mcap: likewise
 from gateway.goby.log.protobuf.log_tool_config_pb2 import LogToolConfig
 from gateway.goby.log.reader import LogReader
 from gateway.goby.log.render import EntryDecoder, debug_text_line, json_dump, json_objects
@@ -113,13 +122,20 @@ def open_output(path: str) -> Iterator[IO[str]]:
         yield f
 
 
-def convert(cfg: LogToolConfig, out: IO[str], reader: LogReader, keep: EntryFilter) -> int:
-    """Write the entries of ``reader`` that ``keep`` accepts, in ``cfg.format``, to ``out``; returns their count."""
-    decoder = EntryDecoder(reader.descriptors)
+@contextmanager
+def open_binary_output(path: str) -> Iterator[IO[bytes]]:
+    if path == "-":
+        yield sys.stdout.buffer
+        sys.stdout.buffer.flush()
+        return
+    with open(path, "wb") as f:
+        yield f
+
+
+def convert_text(cfg: LogToolConfig, out: IO[str], entries: Iterable[LogEntry], decoder: EntryDecoder) -> int:
+    """Write ``entries`` as DEBUG_TEXT lines or JSON objects to ``out``; returns their count."""
     count = 0
-    for entry in reader:
-        if not keep(entry.type_name, entry.group):
-            continue
+    for entry in entries:
         value = decoder.decode(entry)
         if cfg.format == LogToolConfig.DEBUG_TEXT:
             out.write(debug_text_line(entry, value) + "\n")
@@ -128,6 +144,41 @@ def convert(cfg: LogToolConfig, out: IO[str], reader: LogReader, keep: EntryFilt
                 out.write(json_dump(obj) + "\n")
         count += 1
     return count
+
+
+def convert(cfg: LogToolConfig, target: str, reader: LogReader, keep: EntryFilter) -> int:
+    """Write the entries of ``reader`` that ``keep`` accepts to ``target`` in ``cfg.format``; returns their count.
+
+    Raises ``OSError`` when the output cannot be written, ``Hdf5Unavailable``/``McapUnavailable`` without the
+    format's library, ``LogFormatError`` for HDF5 to stdout.
+    """
+    decoder = EntryDecoder(reader.descriptors)
+    counted = [0]
+
+    def entries() -> Iterator[LogEntry]:
+        for entry in reader:
+            if keep(entry.type_name, entry.group):
+                counted[0] += 1
+                yield entry
+
+    if cfg.format == LogToolConfig.HDF5:
+        import_h5py()
+        if target == "-":
+            raise LogFormatError("HDF5 output cannot go to stdout: name an output file")
+        export_hdf5(entries(), decoder, target, zero_length_dim=cfg.write_hdf5_zero_length_dim,
+                    chunk_length=cfg.hdf5_chunk_length if cfg.HasField("hdf5_chunk_length") else None,
+                    compression_level=cfg.hdf5_compression_level if cfg.HasField("hdf5_compression_level") else None)
+    elif cfg.format == LogToolConfig.MCAP:
+        import_mcap_writer()
+        with open_binary_output(target) as out:
+            exporter = McapExporter(out, decoder, metadata={"input_file": cfg.input_file,
+                                                            "goby_log_version": str(reader.version)})
+            exporter.add_all(entries())
+            exporter.finish()
+    else:
+        with open_output(target) as text:
+            convert_text(cfg, text, entries(), decoder)
+    return counted[0]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -140,10 +191,6 @@ def main(argv: list[str] | None = None) -> int:
         return loaded
     cfg = loaded.cfg
     configure_logging(loaded.verbosity, prog)
-    if cfg.format not in (LogToolConfig.DEBUG_TEXT, LogToolConfig.JSON):
-        name = LogToolConfig.OutputFormat.Name(cfg.format)
-        print(f"{prog}: format {name} is not available yet (DEBUG_TEXT and JSON are)", file=sys.stderr)
-        return 1
     try:
         for spec in cfg.load_shared_library:
             load_module(PROTO_MODULES, spec)
@@ -151,10 +198,12 @@ def main(argv: list[str] | None = None) -> int:
         with LogReader(cfg.input_file) as reader:
             target = output_path(cfg)
             try:
-                with open_output(target) as out:
-                    count = convert(cfg, out, reader, keep)
+                count = convert(cfg, target, reader, keep)
             except OSError as exc:
                 print(f"{prog}: cannot write {target}: {exc.strerror or exc}", file=sys.stderr)
+                return 1
+            except (Hdf5Unavailable, McapUnavailable) as exc:
+                print(f"{prog}: {exc}", file=sys.stderr)
                 return 1
             if count == 0 and not reader.skipped:
                 log.warning("input_file: %s has no message entries", cfg.input_file)

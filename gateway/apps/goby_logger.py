@@ -36,6 +36,11 @@ log = logging.getLogger(__name__)
 #: Goby3's ``goby::middleware::groups::logger_request`` (src/middleware/log/groups.h).
 LOGGER_REQUEST_GROUP = "goby::logger::request"
 PROTO_MODULES = ExtensionPoint(group="goby_log.protobuf", what="library", source="load_shared_library")
+#: The logger's receive queue (ZMQ_RCVHWM, messages) when ``interprocess { receive_queue_size }`` is not given:
+#: Goby's default of 1000 is 20 ms at 50,000 messages/s, so a logger descheduled that long on a busy machine lost
+#: messages (bench/bench_logger.py); ZeroMQ's I/O thread keeps reading into this queue while the logger's thread
+#: waits for a CPU.
+LOGGER_RECEIVE_QUEUE = 50_000
 
 
 def load_protobuf_modules(specs: list[str]) -> None:
@@ -68,6 +73,9 @@ class GobyLogger(SingleThreadApplication):
         self._failed = False
         self.open_log()
         self._logging = cfg.log_at_startup
+        ipc = self.context.interprocess_cfg
+        if not ipc.HasField("receive_queue_size"):  # before the portal's sockets exist (first interprocess())
+            ipc.receive_queue_size = LOGGER_RECEIVE_QUEUE
         self.interprocess().subscribe_regex(self._log, group_re.pattern, type_re.pattern, (Scheme.ALL_SCHEMES,))
         self.interprocess().subscribe(LOGGER_REQUEST_GROUP, LoggerRequest, self._on_request)
 

@@ -66,9 +66,12 @@ def index_data(scheme: int, name: str, version: int = CURRENT_VERSION) -> bytes:
     return SCHEME_PREFIX.pack(scheme & 0xFFFF) + raw
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class LogEntry:
-    """One data entry of a log, with its names resolved; ``offset`` is where its ``GBY3`` starts in the file."""
+    """One data entry of a log, with its names resolved; ``offset`` is where its ``GBY3`` starts in the file.
+
+    Not frozen: a reader makes one per entry, and a frozen dataclass costs several times as much to construct.
+    """
 
     scheme: int
     group: str

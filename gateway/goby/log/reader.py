@@ -17,6 +17,7 @@ import mmap
 import os
 import zlib
 from collections.abc import Callable, Iterator
+from typing import Any
 
 from gateway.goby.log.descriptors import FILE_DESCRIPTOR_GROUP, FILE_DESCRIPTOR_TYPE, LogDescriptorPool
 from gateway.goby.log.entry import (
@@ -117,9 +118,19 @@ class LogReader:
         unpack_header = header.unpack_from
         unpack_crc = CRC.unpack_from
         known = KNOWN_SCHEMES
+        # (scheme, group index, type index) -> (group, type, is a descriptor entry); cleared by index entries
+        resolved: dict[tuple[int, int, int], tuple[str, str, bool]] = {}
+        head = b""
+        fields: tuple[Any, ...] = ()
         p = 0 if version == 1 else VERSION.size
         while p < n:
-            if buf[p:p + 4] != MAGIC:
+            if p + hsize + CRC.size <= n:
+                head = buf[p:p + hsize]
+                fields = unpack_header(head)
+                magic = fields[0] == MAGIC
+            else:
+                magic = buf[p:p + 4] == MAGIC
+            if not magic:
                 q = buf.find(MAGIC, p)
                 if q < 0:
                     if MAGIC.startswith(bytes(buf[p:n])):
@@ -129,10 +140,12 @@ class LogReader:
                     return
                 self._skip(p, q - p, "bytes between entries that are not an entry")
                 p = q
+                if p + hsize + CRC.size <= n:
+                    head = buf[p:p + hsize]
+                    fields = unpack_header(head)
             if p + hsize + CRC.size > n:
                 self._skip(p, n - p, "truncated entry at the end of the file (its header is incomplete)")
                 return
-            fields = unpack_header(buf, p)
             size = fields[1]
             end = p + 8 + size
             if size < minimum:
@@ -150,50 +163,55 @@ class LogReader:
                 self._skip(p, q - p, f"entry size {size} runs past the end of the file (corrupt size)")
                 p = q
                 continue
+            data = buf[p + hsize:end - 4]
             (given,) = unpack_crc(buf, end - 4)
-            if crc32(buf[p:end - 4]) != given:
+            calculated = crc32(data, crc32(head))
+            if calculated != given:
                 nxt = end if (end == n or buf[end:end + 4] == MAGIC) else buf.find(MAGIC, p + 4)
                 nxt = n if nxt < 0 else nxt
-                self._skip(p, nxt - p, f"CRC mismatch (given 0x{given:08x}, calculated "
-                                       f"0x{crc32(buf[p:end - 4]):08x})")
+                self._skip(p, nxt - p, f"CRC mismatch (given 0x{given:08x}, calculated 0x{calculated:08x})")
                 p = nxt
                 continue
             scheme, group_index, type_index = fields[2], fields[3], fields[4]
-            timestamp = fields[5] if timestamped else 0
-            data = bytes(buf[p + hsize:end - 4])
             offset = p
             p = end
-            if scheme == SCHEME_GROUP_INDEX or scheme == SCHEME_TYPE_INDEX:
-                if scheme_mapped:
-                    if len(data) < SCHEME_PREFIX.size:
-                        self._skip(offset, end - offset, "index entry without its scheme")
-                        continue
-                    (owner,) = SCHEME_PREFIX.unpack_from(data)
-                    name = data[2:].decode("utf-8", "surrogateescape")
-                else:
-                    owner, name = LEGACY_SCHEME, data.decode("utf-8", "surrogateescape")
-                if scheme == SCHEME_GROUP_INDEX:
-                    groups.setdefault(owner, {})[group_index] = name
-                else:
-                    types.setdefault(owner, {})[type_index] = name
-                continue
-            if scheme not in known:
-                self._skip(offset, end - offset, f"entry of unknown scheme {scheme}")
-                continue
-            key = scheme if scheme_mapped else LEGACY_SCHEME
-            type_name = types.get(key, {}).get(type_index)
-            if type_name is None:
-                type_name = f"_unknown{type_index}_"
-                self._unknown("type", type_index)
-            group = groups.get(key, {}).get(group_index)
-            if group is None:
-                group = f"_unknown{group_index}_"
-                self._unknown("group", group_index)
-            if scheme == Scheme.PROTOBUF and type_name == FILE_DESCRIPTOR_TYPE and group == FILE_DESCRIPTOR_GROUP:
+            names = resolved.get((scheme, group_index, type_index))
+            if names is None:
+                if scheme == SCHEME_GROUP_INDEX or scheme == SCHEME_TYPE_INDEX:
+                    if scheme_mapped:
+                        if len(data) < SCHEME_PREFIX.size:
+                            self._skip(offset, end - offset, "index entry without its scheme")
+                            continue
+                        (owner,) = SCHEME_PREFIX.unpack_from(data)
+                        name = data[2:].decode("utf-8", "surrogateescape")
+                    else:
+                        owner, name = LEGACY_SCHEME, data.decode("utf-8", "surrogateescape")
+                    if scheme == SCHEME_GROUP_INDEX:
+                        groups.setdefault(owner, {})[group_index] = name
+                    else:
+                        types.setdefault(owner, {})[type_index] = name
+                    resolved.clear()
+                    continue
+                if scheme not in known:
+                    self._skip(offset, end - offset, f"entry of unknown scheme {scheme}")
+                    continue
+                key = scheme if scheme_mapped else LEGACY_SCHEME
+                type_name = types.get(key, {}).get(type_index)
+                if type_name is None:
+                    type_name = f"_unknown{type_index}_"
+                    self._unknown("type", type_index)
+                group = groups.get(key, {}).get(group_index)
+                if group is None:
+                    group = f"_unknown{group_index}_"
+                    self._unknown("group", group_index)
+                names = resolved[(scheme, group_index, type_index)] = (
+                    group, type_name,
+                    scheme == Scheme.PROTOBUF and type_name == FILE_DESCRIPTOR_TYPE and group == FILE_DESCRIPTOR_GROUP)
+            if names[2]:
                 self.descriptors.add_file(data)
                 if not self.include_descriptors:
                     continue
-            yield LogEntry(scheme, group, type_name, timestamp, data, offset)
+            yield LogEntry(scheme, names[0], names[1], fields[5] if timestamped else 0, data, offset)
 
     def _unknown(self, what: str, index: int) -> None:
         if (what, index) not in self.unknown_indexes:

@@ -30,7 +30,7 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 
-@dataclass
+@dataclass(slots=True)
 class Decoded:
     """What an entry holds: ``messages`` (PROTOBUF/DCCL), ``text`` (CSTR), ``json`` (JSON), else ``error``."""
 
@@ -48,6 +48,12 @@ class EntryDecoder:
         self._codec: Codec | None = None
         self.warned: set[tuple[int, str]] = set()
         self.undecoded = 0
+        self._protobuf: dict[str, type[pb_message.Message]] = {}  # PROTOBUF types that decoded: the fast path
+
+    @property
+    def pool(self) -> LogDescriptorPool:
+        """The descriptors of the log being decoded."""
+        return self._pool
 
     def _dccl(self) -> Codec:
         if self._codec is None:
@@ -57,6 +63,13 @@ class EntryDecoder:
         return self._codec
 
     def decode(self, entry: LogEntry) -> Decoded:
+        if entry.scheme == Scheme.PROTOBUF:
+            cls = self._protobuf.get(entry.type_name)
+            if cls is not None:
+                try:
+                    return Decoded([cls.FromString(entry.data)])
+                except Exception:  # noqa: BLE001, S110 - the full path below reports it
+                    pass
         try:
             out = self._decode(entry)
         except Exception as exc:  # noqa: BLE001 - any failure of a codec on foreign bytes is reported, never raised
@@ -83,13 +96,21 @@ class EntryDecoder:
                 return Decoded(error=f"Failed to create Protobuf message of type: {entry.type_name}, reason: "
                                      f"unknown type (no descriptor in the log or this process)")
             if scheme == Scheme.PROTOBUF:
-                msg = cls()
-                msg.ParseFromString(entry.data)
+                msg = cls.FromString(entry.data)
+                self._protobuf[entry.type_name] = cls
                 return Decoded(messages=[msg])
             codec = self._dccl()
             codec.load(cls)
             return Decoded(messages=codec.decode_all(entry.data))
         return Decoded(error=f"No plugin available for scheme: {scheme}")
+
+
+def scheme_name(scheme: int) -> str:
+    """``PROTOBUF``, ``DCCL``...: a scheme's name, or its number when Goby does not define it."""
+    try:
+        return Scheme(scheme).name
+    except ValueError:
+        return str(scheme)
 
 
 def _one_line(text: str) -> str:

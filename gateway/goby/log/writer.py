@@ -25,7 +25,7 @@ from gateway.goby.log.entry import (
 from gateway.goby.log.errors import LogWriteError
 from gateway.goby.portal.marshalling import Scheme
 
-Sink = Callable[[bytes], None]
+Sink = Callable[[bytes], object]  # e.g. bytearray.extend, a file's write
 
 
 class LogWriter:
