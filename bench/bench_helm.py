@@ -34,7 +34,6 @@ import math
 import os
 import shutil
 import statistics
-import subprocess
 import sys
 import threading
 import time
@@ -47,6 +46,7 @@ from tempfile import TemporaryDirectory
 from behaviors.helm.helm import Helm
 from behaviors.helm.testing import helm_from_text
 from behaviors.testing import ORIGIN, write_helm_mission
+from bench.netns import NETNS_FLAG, reexec_in_netns
 from bench.platform_proc import ProcSample, process_cpu_between, sample
 from bench.stats import markdown_table
 from gateway.moos import MoosClock, comms
@@ -55,7 +55,6 @@ from util.geodesy import UTMGeodesy
 from util.process import ChildProcess
 
 REPO = Path(__file__).resolve().parents[1]
-NETNS_FLAG = "--in-netns"
 MIB = 2**20
 HELM_NAME = "pHelmIvP"  # both helms connect under pHelmIvP's name and read its block
 NAV_VARS = ("NAV_X", "NAV_Y", "NAV_LAT", "NAV_LONG", "NAV_Z", "NAV_DEPTH", "NAV_HEADING", "NAV_YAW", "NAV_SPEED")
@@ -355,23 +354,6 @@ def live_table(runs: list[dict[str, SideFigures]], reference: str | None) -> str
 
 
 # ---- the private network namespace ----------------------------------------------------------------------------
-def reexec_in_netns(argv: list[str]) -> int | None:
-    """Run this benchmark again inside a private network namespace (loopback up); None (and why) if impossible."""
-    unshare = shutil.which("unshare")
-    if unshare is None:
-        progress("(pHelmIvP skipped: it listens on all addresses and `unshare` is missing)")
-        return None
-    user = [] if os.geteuid() == 0 else ["-r"]
-    base = [unshare, *user, "-n", "bash", "-c", 'ip link set lo up && exec "$@"', "bench_helm"]
-    probe = subprocess.run([*base, "true"], capture_output=True, text=True)
-    if probe.returncode != 0:
-        progress(f"(pHelmIvP skipped: no private network namespace: {probe.stderr.strip()[-200:]})")
-        return None
-    progress("(running inside a private network namespace: pHelmIvP listens on all addresses)")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (os.environ.get("PYTHONPATH"), str(REPO)) if p))
-    return subprocess.call([*base, sys.executable, "-m", "bench.bench_helm", *argv, NETNS_FLAG], env=env)
-
-
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     parser = argparse.ArgumentParser(prog="python -m bench.bench_helm", description=__doc__,
@@ -393,7 +375,8 @@ def main(argv: list[str] | None = None) -> int:
             parser.error(f"--python-root {root}: no behaviors/apps/ivp_helm.py there")
     phelmivp, why_not = (None, "--no-live") if args.no_live else find_phelmivp()
     if phelmivp is not None and not args.in_netns and not private_netns():
-        code = reexec_in_netns(argv)
+        code = reexec_in_netns("bench.bench_helm", argv, "pHelmIvP", "pHelmIvP listens on all addresses",
+                               say=progress)
         if code is not None:
             return code
         phelmivp, why_not = None, "no private network namespace"

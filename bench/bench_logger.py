@@ -41,6 +41,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+from bench.netns import NETNS_FLAG, reexec_in_netns
 from bench.stats import markdown_table
 from gateway.goby.log import FILE_DESCRIPTOR_GROUP, EntryDecoder, LogReader, LogWriter, debug_text_line
 from gateway.goby.portal import Scheme
@@ -53,7 +54,6 @@ from util.cli import bounded_number
 from util.process import ChildProcess
 
 HERE = Path(__file__).resolve().parent.parent
-NETNS_FLAG = "--in-netns"
 PY = sys.executable
 GROUP = "bench::log"
 TYPE = Sample.DESCRIPTOR.full_name
@@ -392,23 +392,6 @@ def rates_table(rates: list[PlatformRate], hours: float) -> str:
 
 
 # ---- the private network namespace ------------------------------------------------------------------------------
-def reexec_in_netns(argv: list[str]) -> int | None:
-    unshare = shutil.which("unshare")
-    if unshare is None:
-        progress("(C++ logger skipped: the real gobyd listens on all addresses and `unshare` is missing)")
-        return None
-    user = [] if os.geteuid() == 0 else ["-r"]
-    # multicast on loopback, with a route, as bench_platform: the trail mission's links run in there too
-    script = 'ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo && exec "$@"'
-    head = [unshare, *user, "-n", "bash", "-c", script, "bench_logger"]
-    probe = subprocess.run([*head, "true"], capture_output=True, text=True)
-    if probe.returncode != 0:
-        progress(f"(C++ logger skipped: no private network namespace: {probe.stderr.strip()[-200:]})")
-        return None
-    progress("(running inside a private network namespace: the real gobyd listens on all addresses)")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (os.environ.get("PYTHONPATH"), str(HERE)) if p))
-    return subprocess.call([*head, PY, "-m", "bench.bench_logger", *argv, NETNS_FLAG], env=env)
-
 
 def logger_part(args: argparse.Namespace, sides: list[str], programs: dict[str, str], work: Path) -> None:
     print(f"## goby-logger{' vs goby_logger' if programs else ''}: one publisher, {args.seconds:g} s per rate, "
@@ -483,7 +466,8 @@ def main(argv: list[str] | None = None) -> int:
         elif args.in_netns or private_netns():
             programs = found
         else:
-            status = reexec_in_netns(argv)
+            status = reexec_in_netns("bench.bench_logger", argv, "C++ logger", "the real gobyd listens on all addresses",
+                                     say=progress)
             if status is not None:
                 return status
     sides = ["python", *(["cpp"] if programs else [])]

@@ -28,7 +28,6 @@ import os
 import shutil
 import signal
 import statistics
-import subprocess
 import sys
 import tempfile
 import threading
@@ -37,13 +36,13 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+from bench.netns import NETNS_FLAG, reexec_in_netns
 from bench.stats import markdown_table, median_p99
 from gateway.moos.factory import choose_client, pymoos_available
 from gateway.moos.testing import moosdb_process, private_netns, real_moos_skip_reason
 from util.process import ChildProcess
 
 HERE = Path(__file__).resolve().parents[1]
-NETNS_FLAG = "--in-netns"
 
 
 # ---- client side (child processes) --------------------------------------------------------------------------
@@ -459,39 +458,6 @@ LEGEND = ("RTT: A notifies PING, B echoes PONG, A receives it (median / p99 of t
 
 
 # ---- the private network namespace for the real MOOSDB -----------------------------------------------------
-def netns_command(argv: list[str]) -> tuple[list[str] | None, str]:
-    """The command that re-runs this benchmark inside a private network namespace, or None and why not."""
-    bin_dir = os.environ.get("MOOS_IVP_BIN", "")
-    if shutil.which("MOOSDB") is None and not (bin_dir and (Path(bin_dir) / "MOOSDB").exists()):
-        return None, "the real MOOSDB is not on PATH (set MOOS_IVP_BIN to the MOOS-IvP bin directory)"
-    unshare = shutil.which("unshare")
-    if unshare is None:
-        return None, "the real MOOSDB listens on all addresses and `unshare` is missing to isolate it"
-    user = [] if os.geteuid() == 0 else ["-r"]
-    script = 'ip link set lo up && exec "$@"'
-    return [unshare, *user, "-n", "bash", "-c", script, "bench", sys.executable, "-m", "bench.bench_moos",
-            *argv, NETNS_FLAG], ""
-
-
-def reexec_in_netns(argv: list[str]) -> int | None:
-    """Run this benchmark again inside a private network namespace; None when it cannot (C++ columns skipped)."""
-    cmd, why = netns_command(argv)
-    if cmd is None:
-        print(f"(C++ columns skipped: {why})", flush=True)
-        return None
-    env = dict(os.environ)
-    if env.get("MOOS_IVP_BIN"):
-        env["PATH"] = env["MOOS_IVP_BIN"] + os.pathsep + env.get("PATH", "")
-    if env.get("PYMOOS_PATH"):
-        env["PYTHONPATH"] = os.pathsep.join(p for p in (env.get("PYTHONPATH"), env["PYMOOS_PATH"]) if p)
-    probe = subprocess.run(cmd[: cmd.index("bench") + 1] + ["true"], env=env, capture_output=True, text=True)
-    if probe.returncode != 0:
-        print(f"(C++ columns skipped: cannot make a private network namespace: {probe.stderr.strip()[-200:]})",
-              flush=True)
-        return None
-    print("(re-running inside a private network namespace for the real MOOSDB)", flush=True)
-    return subprocess.call(cmd, env=env, cwd=HERE)
-
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
@@ -520,9 +486,19 @@ def main(argv: list[str] | None = None) -> int:
         return 0
 
     if not args.ours_only and not args.in_netns and not private_netns():
-        status = reexec_in_netns(argv)
-        if status is not None:
-            return status
+        env = dict(os.environ)
+        if env.get("MOOS_IVP_BIN"):
+            env["PATH"] = env["MOOS_IVP_BIN"] + os.pathsep + env.get("PATH", "")
+        if env.get("PYMOOS_PATH"):
+            env["PYTHONPATH"] = os.pathsep.join(p for p in (env.get("PYTHONPATH"), env["PYMOOS_PATH"]) if p)
+        if shutil.which("MOOSDB", path=env.get("PATH")) is None:
+            print("(C++ columns skipped: the real MOOSDB is not on PATH (set MOOS_IVP_BIN to the MOOS-IvP bin "
+                  "directory))", flush=True)
+        else:
+            status = reexec_in_netns("bench.bench_moos", argv, "C++ columns", "the real MOOSDB listens on all "
+                                     "addresses", env=env, say=lambda line: print(line, flush=True))
+            if status is not None:
+                return status
     combos = [("ours", "ours")]
     if not args.ours_only:
         real_db = real_moos_skip_reason("MOOSDB") is None

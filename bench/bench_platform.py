@@ -31,9 +31,7 @@ from __future__ import annotations
 import argparse
 import logging
 import os
-import shutil
 import statistics
-import subprocess
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -41,6 +39,7 @@ from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 
+from bench.netns import NETNS_FLAG, reexec_in_netns
 from bench.platform_import_report import import_report
 from bench.platform_proc import ProcSample, cpu_between
 from bench.platform_vehicle import (
@@ -64,7 +63,6 @@ from util.logsetup import add_verbosity_argument, configure_logging
 log = logging.getLogger(__name__)
 
 HERE = Path(__file__).resolve().parent.parent
-NETNS_FLAG = "--in-netns"
 MIB = 2**20
 
 
@@ -212,36 +210,6 @@ def checks(runs: list[dict[str, SideResult]]) -> str:
 
 
 # ---- the private network namespace ------------------------------------------------------------------------------
-def netns_command(argv: list[str]) -> list[str] | None:
-    """The command that runs this benchmark again inside a private network namespace: loopback up, with
-    multicast."""
-    unshare = shutil.which("unshare")
-    if unshare is None:
-        return None
-    user = [] if os.geteuid() == 0 else ["-r"]
-    # Goby's UDP multicast driver (gobyd's satellite link) joins its group without naming an interface: the
-    # kernel needs a multicast route, which a fresh namespace lacks (ENODEV); ours names 127.0.0.1 and needs none
-    script = 'ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo && exec "$@"'
-    return [unshare, *user, "-n", "bash", "-c", script, "bench_platform",
-            sys.executable, "-m", "bench.bench_platform", *argv, NETNS_FLAG]
-
-
-def reexec_in_netns(argv: list[str]) -> int | None:
-    """Run again inside a private network namespace; None (and why, on stderr) when that is not possible."""
-    cmd = netns_command(argv)
-    if cmd is None:
-        progress("(C++ vehicle skipped: the real MOOSDB listens on all addresses and `unshare` is missing)")
-        return None
-    probe = subprocess.run(cmd[: cmd.index("bench_platform") + 1] + ["true"], capture_output=True, text=True)
-    if probe.returncode != 0:
-        progress(f"(C++ vehicle skipped: no private network namespace: {probe.stderr.strip()[-200:]})")
-        return None
-    progress("(running inside a private network namespace: the real MOOSDB listens on all addresses)")
-    # this checkout after any PYTHONPATH given, so `-m bench.bench_platform` is found from any directory
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (os.environ.get("PYTHONPATH"), str(HERE)) if p))
-    return subprocess.call(cmd, env=env)
-
-
 # ---- main -------------------------------------------------------------------------------------------------------
 def warps(text: str) -> list[int]:
     try:
@@ -294,7 +262,8 @@ def main(argv: list[str] | None = None) -> int:
         elif args.in_netns or private_netns():
             programs = found
         else:
-            status = reexec_in_netns(argv)
+            status = reexec_in_netns("bench.bench_platform", argv, "C++ vehicle",
+                                     "the real MOOSDB listens on all addresses", say=progress)
             if status is not None:
                 return status
     print(f"one USV vehicle, Python{' vs C++' if programs else ''}: {args.seconds:g} s measured per run after "

@@ -1,0 +1,46 @@
+"""Re-running a benchmark inside a private network namespace, for the C++ programs it runs beside ours.
+
+The real MOOSDB, pHelmIvP and gobyd listen on every address, so a benchmark that starts them re-executes itself
+under ``unshare -n`` (``-r`` when not root) and runs both sides in there: loopback up, with multicast and a route for
+it (Goby's UDP multicast driver joins its group without naming an interface, which needs a multicast route a fresh
+namespace lacks; ours names 127.0.0.1 and needs none). The re-run gets ``--in-netns`` so it does not do it again.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from collections.abc import Callable, Mapping
+from pathlib import Path
+
+NETNS_FLAG = "--in-netns"
+REPO = Path(__file__).resolve().parents[1]
+SCRIPT = 'ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo && exec "$@"'
+
+
+def _say(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
+def reexec_in_netns(module: str, argv: list[str], skipped: str, why_needed: str,
+                    env: Mapping[str, str] | None = None, say: Callable[[str], None] = _say) -> int | None:
+    """Run ``python -m module *argv --in-netns`` inside a new private network namespace and return its exit status;
+    None when no namespace can be made (then ``"(<skipped> skipped: <reason>)"`` is said and the caller runs ours
+    alone). ``why_needed`` ends the line said before the re-run; ``env`` replaces the environment (this checkout is
+    appended to its PYTHONPATH either way, so ``-m module`` is found from any directory)."""
+    unshare = shutil.which("unshare")
+    if unshare is None:
+        say(f"({skipped} skipped: {why_needed} and `unshare` is missing)")
+        return None
+    user = [] if os.geteuid() == 0 else ["-r"]
+    head = [unshare, *user, "-n", "bash", "-c", SCRIPT, module.rsplit(".", 1)[-1]]
+    base = dict(os.environ if env is None else env)
+    base["PYTHONPATH"] = os.pathsep.join(p for p in (base.get("PYTHONPATH"), str(REPO)) if p)
+    probe = subprocess.run([*head, "true"], env=base, capture_output=True, text=True)
+    if probe.returncode != 0:
+        say(f"({skipped} skipped: no private network namespace: {probe.stderr.strip()[-200:]})")
+        return None
+    say(f"(running inside a private network namespace: {why_needed})")
+    return subprocess.call([*head, sys.executable, "-m", module, *argv, NETNS_FLAG], env=base, cwd=REPO)
