@@ -30,9 +30,9 @@ from typing import IO
 from google.protobuf import message as pb_message
 
 from gateway.goby.log.entry import LogEntry
-from gateway.goby.log.errors import LogFormatError
-from gateway.goby.log.hdf5_export import Hdf5Unavailable, export_hdf5, import_h5py  # h5py: imported when used
-from gateway.goby.log.mcap_export import McapExporter, McapUnavailable, import_mcap_writer  # mcap: likewise
+from gateway.goby.log.errors import ExportUnavailable, LogFormatError
+from gateway.goby.log.hdf5_export import export_hdf5, import_h5py  # h5py: imported when used
+from gateway.goby.log.mcap_export import McapExporter, import_mcap_writer  # mcap: likewise
 from gateway.goby.log.protobuf.log_tool_config_pb2 import LogToolConfig
 from gateway.goby.log.reader import LogReader
 from gateway.goby.log.render import EntryDecoder, debug_text_line, json_dump, json_objects
@@ -149,7 +149,7 @@ def convert_text(cfg: LogToolConfig, out: IO[str], entries: Iterable[LogEntry], 
 def convert(cfg: LogToolConfig, target: str, reader: LogReader, keep: EntryFilter) -> int:
     """Write the entries of ``reader`` that ``keep`` accepts to ``target`` in ``cfg.format``; returns their count.
 
-    Raises ``OSError`` when the output cannot be written, ``Hdf5Unavailable``/``McapUnavailable`` without the
+    Raises ``OSError`` when the output cannot be written, ``ExportUnavailable`` without the
     format's library, ``LogFormatError`` for HDF5 to stdout.
     """
     decoder = EntryDecoder(reader.descriptors)
@@ -202,7 +202,7 @@ def main(argv: list[str] | None = None) -> int:
             except OSError as exc:
                 print(f"{prog}: cannot write {target}: {exc.strerror or exc}", file=sys.stderr)
                 return 1
-            except (Hdf5Unavailable, McapUnavailable) as exc:
+            except ExportUnavailable as exc:
                 print(f"{prog}: {exc}", file=sys.stderr)
                 return 1
             if count == 0 and not reader.skipped:

@@ -38,6 +38,7 @@ from google.protobuf import message_factory
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 
 from gateway.goby.log.entry import LogEntry
+from gateway.goby.log.errors import import_optional
 from gateway.goby.log.render import EntryDecoder, scheme_name
 from gateway.goby.portal.marshalling import Scheme
 
@@ -54,18 +55,9 @@ SECONDS_PER_DAY = 86400.0
 FILE_DESCRIPTOR_PROTO = "google.protobuf.FileDescriptorProto"
 
 
-class Hdf5Unavailable(RuntimeError):
-    """h5py (or numpy) is not installed: the message names the ``log`` extra."""
-
-
 def import_h5py() -> Any:
-    """h5py, or ``Hdf5Unavailable`` saying how to install it."""
-    try:
-        import h5py  # noqa: PLC0415 - optional dependency, imported only when HDF5 is asked for
-    except ImportError as exc:
-        raise Hdf5Unavailable(f"HDF5 output needs h5py ({exc}): install the 'log' extra "
-                              "(pip install 'goby-moos-py[log]' or pip install h5py)") from None
-    return h5py
+    """h5py, or ``ExportUnavailable`` saying how to install it."""
+    return import_optional("h5py", "HDF5")
 
 
 @dataclass(frozen=True, slots=True)
@@ -378,7 +370,7 @@ def export_hdf5(entries: Iterable[LogEntry], decoder: EntryDecoder, path: str, *
     """Write the PROTOBUF and DCCL entries of ``entries`` to the HDF5 file ``path`` (created or truncated).
 
     Entries of other schemes, and entries that do not decode (the decoder warns once per type), are counted in
-    ``left_out``. Raises ``Hdf5Unavailable`` without h5py and ``OSError`` when ``path`` cannot be written.
+    ``left_out``. Raises ``ExportUnavailable`` without h5py and ``OSError`` when ``path`` cannot be written.
     """
     h5py = import_h5py()
     stats = Hdf5Stats()

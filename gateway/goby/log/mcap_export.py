@@ -31,6 +31,7 @@ from google.protobuf import descriptor_pb2
 from google.protobuf.descriptor import Descriptor, FileDescriptor
 
 from gateway.goby.log.entry import LogEntry
+from gateway.goby.log.errors import import_optional
 from gateway.goby.log.render import EntryDecoder, scheme_name
 from gateway.goby.portal.marshalling import Scheme
 
@@ -47,18 +48,9 @@ JSON_SCHEMA = {"description": "a JSON (BSON in the .goby log) publication of a G
 LIBRARY = "gateway goby-log-tool"
 
 
-class McapUnavailable(RuntimeError):
-    """The ``mcap`` library is not installed: the message names the ``log`` extra."""
-
-
 def import_mcap_writer() -> Any:
-    """``mcap.writer``, or ``McapUnavailable`` saying how to install it."""
-    try:
-        from mcap import writer  # noqa: PLC0415 - optional dependency, imported only when MCAP is asked for
-    except ImportError as exc:
-        raise McapUnavailable(f"MCAP output needs the mcap library ({exc}): install the 'log' extra "
-                              "(pip install 'goby-moos-py[log]' or pip install mcap)") from None
-    return writer
+    """``mcap.writer``, or ``ExportUnavailable`` saying how to install it."""
+    return import_optional("mcap.writer", "MCAP")
 
 
 def file_descriptor_set(desc: Descriptor) -> bytes:
