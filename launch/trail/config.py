@@ -73,7 +73,7 @@ def _values(settings: TrailSettings, vehicle: Vehicle, app: str) -> dict[str, ob
         "lon_origin": repr(settings.lon_origin),
         "platform": vehicle.name,
         "socket_name": vehicle.ipc_base(settings),
-        "moos_host": "127.0.0.1",
+        "moos_host": settings.moos_address,
         "moos_port": vehicle.moos_port(settings),
         "sim_port": vehicle.sim_port(settings),
         "vehicle_id": vehicle.vehicle_id,
@@ -85,8 +85,21 @@ def _values(settings: TrailSettings, vehicle: Vehicle, app: str) -> dict[str, ob
         "south_duration": settings.south_duration,
     }
     values["app_block"] = render(SHARED_TEMPLATES / "_app.pb.cfg.in", values)
-    values["interprocess_block"] = render(SHARED_TEMPLATES / "_interprocess.pb.cfg.in", values)
+    values["interprocess_block"] = (render(SHARED_TEMPLATES / "_interprocess.pb.cfg.in", values)
+                                    if not settings.broker_address else _tcp_interprocess(settings, vehicle))
     return values
+
+
+def _tcp_interprocess(settings: TrailSettings, vehicle: Vehicle) -> str:
+    """Goby's interprocess TCP transport (a vehicle of two computers, docs/hosts.md): the broker binds
+    ``ipv4_address:tcp_port`` and every app of the vehicle, on either computer, connects there."""
+    return f"""interprocess {{
+  platform: "{vehicle.name}"
+  transport: TCP
+  ipv4_address: "{settings.broker_address}"  # TRAIL_BROKER_ADDRESS
+  tcp_port: {settings.broker_port}  # TRAIL_BROKER_PORT
+  manager_timeout_seconds: 30
+}}"""
 
 
 def _pb(template: str, app: str) -> Callable[[TrailSettings, Vehicle], str]:
@@ -119,13 +132,28 @@ def link_block(settings: TrailSettings, vehicle: Vehicle, link: str) -> str:
         multicast_address: "{MULTICAST_ADDRESS}"
         multicast_port: {port}
         max_frame_size: 1400
-      }}{_channel_block(settings, link)}
+      }}{_peers_block(settings)}{_channel_block(settings, link)}
     }}
     mac {{
       type: MAC_FIXED_DECENTRALIZED
 {slot_lines}
     }}
   }}"""
+
+
+def _peers_block(settings: TrailSettings) -> str:
+    """Our ``udp_peers`` extension: the only sources the link accepts (TRAIL_LINK_PEERS), when given."""
+    peers = " ".join(f'peer_address: "{p}"' for p in settings.peer_networks())
+    if not peers:
+        return ""
+    return ("\n      # datagrams from other sources are dropped (TRAIL_LINK_PEERS, docs/hosts.md)"
+            f"\n      [goby_moos_py.acomms.protobuf.udp_peers] {{ {peers} }}")
+
+
+def _moosdb_flags(settings: TrailSettings, vehicle: Vehicle) -> str:
+    """Our moos-db's ``--moos_address`` (TRAIL_MOOS_ADDRESS); nothing for the real MOOSDB, which binds every
+    interface of its host."""
+    return "" if settings.moosdb == "MOOSDB" else f"--moos_address={settings.moos_address}"
 
 
 def _channel_block(settings: TrailSettings, link: str) -> str:
@@ -276,6 +304,7 @@ GENERATORS: dict[str, Callable[[TrailSettings, Vehicle], str]] = {
     "helm": _vehicle_only(("usv",), "helm", _pb("helm.pb.cfg.in", "goby-helm-example")),
     "helm_command": _vehicle_only(("usv",), "helm_command", _helm_command),
     "commander": _vehicle_only(("topside",), "commander", _pb("commander.pb.cfg.in", "trail-commander")),
+    "moosdb_flags": _vehicle_only(("usv", "auv"), "moosdb_flags", _moosdb_flags),
     "moos": lambda s, v: str(write_moos_files(s, v)[0]),
     "bhv": lambda s, v: str(write_moos_files(s, v)[1]),
 }

@@ -10,6 +10,11 @@ prints a summary. Exit status 0 only if the mission ran and every process stoppe
 modem driver of the link applies the channel to what it receives (our ``channel_model`` extension of the driver
 block, docs/intervehicle.md "Lossy channels"); the summary prints the channels and, per link, the commands sent,
 acked and expired.
+
+``--hosts`` runs every platform on its own host: a Linux network namespace with its own address on a private
+bridge (``launch.hosts``; root only), each platform's goby-launch inside it with configs on that address; the links'
+multicast groups cross the bridge. ``--split-usv`` also puts the USV on two hosts joined by Goby's interprocess
+TCP transport (docs/hosts.md).
 """
 
 from __future__ import annotations
@@ -25,11 +30,13 @@ from pathlib import Path
 
 from gateway.goby.acomms.channel import MAX_DELAY_S, describe
 from launch.demo import add_run_arguments, demo_main, fresh_run_dir, run_mission, schedule_type, whole_number
+from launch.errors import LaunchError
+from launch.hosts import HostNetwork, unavailable
 from launch.mission import choose_program
 from launch.record import MissionRecord, shifted
 from launch.trail.analysis import command_outcomes, recover_outcome, trail_performance
 from launch.trail.links import LinkMonitor
-from launch.trail.mission import TrailMission, TrailResult, with_free_ports
+from launch.trail.mission import HostPlan, TrailMission, TrailResult, use_interprocess, with_free_ports
 from launch.trail.operator import SCHEDULE_HELP, Operator, PortalWorker, parse_trail_schedule
 from launch.trail.plot import write_trail_png
 from launch.trail.settings import CHANNEL_LINKS, TrailSettings, Vehicle, channel_text
@@ -129,6 +136,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--listen", default="127.0.0.1", metavar="ADDRESS",
                         help="address the liaison pages listen on (default 127.0.0.1). RISK: another address lets "
                         "anyone who can reach it watch all traffic and command the vehicles: the pages have no login")
+    hosts = parser.add_argument_group("hosts", "one platform per host (root only; docs/hosts.md)")
+    hosts.add_argument("--hosts", action="store_true",
+                       help="run each platform in its own network namespace with its own address on a private "
+                       "bridge; links, MOOSDBs, brokers and pages bind that address (--listen is then ignored)")
+    hosts.add_argument("--split-usv", action="store_true",
+                       help="with --hosts: the USV on two hosts, frontseat simulator and interface on one, broker, "
+                       "MOOS and helm on the other, joined by Goby's interprocess TCP transport")
     parser.add_argument("--keep-going", action="store_true",
                         help="when a platform's process dies (its goby-launch then stops that platform), keep the "
                         "other platforms running; the summary says what died when (default: stop everything)")
@@ -136,7 +150,9 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> TrailSettings:
+def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path, console: str = "") -> TrailSettings:
+    """The run's settings; with hosts, ``console`` (the bridge's address here) is where the demo joins the links'
+    groups (each launcher's own variables put its configs on its host, ``HostPlan.environment``)."""
     channels = channel_settings(args)
     settings = TrailSettings(
         run_dir=run_dir,
@@ -150,6 +166,7 @@ def make_settings(args: argparse.Namespace, run_dir: Path, socket_dir: Path) -> 
         south_duration=args.south_duration,
         acomms_channel=channels["acomms"],
         satellite_channel=channels["satellite"],
+        link_address=console or TrailSettings.link_address,
     )
     return with_free_ports(settings, args.auvs, prefer_course=True)
 
@@ -198,14 +215,15 @@ def report(result: TrailResult, operator: MissionRecord, n_auvs: int, links: Lin
                         channels)
 
 
-def liaison_urls_line(settings: TrailSettings, n_auvs: int) -> str:
+def liaison_urls_line(settings: TrailSettings, n_auvs: int, hosts: HostPlan | None = None) -> str:
     """Where the platforms' goby-liaison pages are: the topside's commander (USVCommand over the satellite link)
-    and every vehicle's scope, at port 50000 + platform id as in the course."""
-    host = "127.0.0.1" if settings.liaison_address in ("", "0.0.0.0", "::") else settings.liaison_address
+    and every vehicle's scope, at port 50000 + platform id as in the course (on each host's address with hosts)."""
+    default = "127.0.0.1" if settings.liaison_address in ("", "0.0.0.0", "::") else settings.liaison_address
     vehicles = [Vehicle("topside", n_auvs), Vehicle("usv", n_auvs), *(Vehicle("auv", n_auvs, i) for i in range(n_auvs))]
-    pages = [f"{v.name} http://{host}:{v.liaison_port(settings)}/" for v in vehicles]
+    where = {v.name: default if hosts is None else hosts.address(v) for v in vehicles}
+    pages = [f"{v.name} http://{where[v.name]}:{v.liaison_port(settings)}/" for v in vehicles]
     return (f"web pages (goby-liaison): {', '.join(pages)}; command the USV from "
-            f"http://{host}:{vehicles[0].liaison_port(settings)}/?_=/commander")
+            f"http://{where['topside']}:{vehicles[0].liaison_port(settings)}/?_=/commander")
 
 
 def _report(line: str) -> None:
@@ -217,9 +235,26 @@ def _report(line: str) -> None:
 
 
 def run_demo(args: argparse.Namespace) -> int:
+    if args.split_usv and not args.hosts:
+        raise LaunchError("--split-usv needs --hosts")
+    if not args.hosts:
+        return _run_demo(args, None)
+    reason = unavailable()
+    if reason is not None:
+        raise LaunchError(f"--hosts: {reason}")
+    with HostNetwork(HostPlan.names(args.auvs, args.split_usv)) as network:
+        plan = HostPlan.from_network(network, args.split_usv)
+        print("hosts: " + ", ".join(f"{h.name} {h.address} ({h.netns})" for h in network.hosts.values())
+              + f"; console {network.console} on bridge {network.bridge}"
+              + ("; the USV on two hosts over Goby's interprocess TCP transport "
+                 f"({plan.hosts['usv'].address}:{plan.broker_port})" if args.split_usv else ""), flush=True)
+        return _run_demo(args, plan)
+
+
+def _run_demo(args: argparse.Namespace, hosts: HostPlan | None) -> int:
     out: Path = args.out.resolve()
     run_dir, socket_dir = fresh_run_dir(out, "trail-", MAX_SOCKET_BASE)
-    settings = make_settings(args, run_dir, socket_dir)
+    settings = make_settings(args, run_dir, socket_dir, "" if hosts is None else hosts.console)
     schedule = args.schedule if args.schedule is not None else DEFAULT_SCHEDULE[args.usv_helm]
     plan = parse_trail_schedule(schedule)
     duration = args.duration if args.duration > 0 else None
@@ -229,7 +264,7 @@ def run_demo(args: argparse.Namespace) -> int:
     print(f"schedule: {schedule}", flush=True)
     channels = channel_descriptions(settings)
     print("channels: " + "; ".join(f"{link} {text}" for link, text in channels.items()), flush=True)
-    mission = TrailMission(settings, n, report=_report, keep_going=args.keep_going)
+    mission = TrailMission(settings, n, report=_report, keep_going=args.keep_going, hosts=hosts)
     links = LinkMonitor(settings, n)
     mission.add_hook(links.poll)
     operator_record = MissionRecord()
@@ -241,10 +276,14 @@ def run_demo(args: argparse.Namespace) -> int:
         nonlocal sim_seconds
         print(f"starting {len(mission.entries)} platforms ...", flush=True)
         mission.start()
-        print(liaison_urls_line(settings, n), flush=True)
+        print(liaison_urls_line(settings, n, hosts), flush=True)
         topside = PortalWorker("topside", Vehicle("topside", n).ipc_base(settings), settings.warp)
         usv = PortalWorker("usv", Vehicle("usv", n).ipc_base(settings), settings.warp) if args.usv_helm == "ivp" else None
         workers.extend(w for w in (topside, usv) if w is not None)
+        if hosts is not None:
+            for worker, vehicle in ((topside, Vehicle("topside", n)), (usv, Vehicle("usv", n))):
+                if worker is not None:
+                    use_interprocess(worker, hosts.interprocess(vehicle, settings))
         for worker in workers:
             worker.start()
         topside.watch_node_status(operator_record, mission.clock)

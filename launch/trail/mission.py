@@ -9,6 +9,7 @@ the recorders started, so vehicles and commands line up.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import random
 import socket
@@ -19,10 +20,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from gateway.goby.portal.endpoints import ipc_manager_path
+from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
 from launch.apps.goby_launch import LAUNCH_DIR_VAR, LOG_DIR_VAR, PLATFORM_VAR
 from launch.errors import LaunchError, ProcessDiedError
+from launch.hosts import Host, HostNetwork
 from launch.launchfile import LaunchEntry, parse_file, parse_lines
 from launch.mission import ProcessOutcome, outcomes, scan_log_files
+from launch.portal_thread import BackgroundPortalThread
 from launch.process_group import ProcessGroup, child_environment
 from launch.record import MissionRecord, shifted
 from launch.recorder import MoosRecorder, PortalRecorder, SimClock
@@ -46,6 +50,107 @@ def all_launch_entries(n_auvs: int) -> list[LaunchEntry]:
 def platform_entries(vehicle: Vehicle) -> list[LaunchEntry]:
     """One platform's launch file as its own run (what ``goby-launch usv.launch`` runs)."""
     return parse_file(TRAIL_DIR / f"{vehicle.kind}.launch").entries
+
+
+USV_FRONTSEAT = "usv_frontseat"  # the launcher (and host) of the USV's frontseat computer when it has two
+
+
+@dataclass(frozen=True)
+class HostPlan:
+    """Where each launcher of a run goes (one platform per host, docs/hosts.md): ``hosts`` by launcher name
+    (``topside``, ``usv``, ``auv<i>``, and ``usv_frontseat`` when ``split_usv``), the console's address (where the
+    demo's recorders connect from), and the subnet the links accept datagrams from."""
+
+    hosts: dict[str, Host]
+    console: str
+    peers: str
+    split_usv: bool = False
+    broker_port: int = 11144
+
+    @staticmethod
+    def names(n_auvs: int, split_usv: bool = False) -> list[str]:
+        """The hosts a run needs, in launch order."""
+        names = [v.name for v in fleet(n_auvs)]
+        return [*names[:2], USV_FRONTSEAT, *names[2:]] if split_usv else names
+
+    @classmethod
+    def from_network(cls, network: HostNetwork, split_usv: bool = False, broker_port: int = 11144) -> HostPlan:
+        return cls(dict(network.hosts), network.console, str(network.subnet), split_usv, broker_port)
+
+    def address(self, vehicle: Vehicle) -> str:
+        """The vehicle's address: its (backseat) host's, where its MOOSDB and, over TCP, its broker listen."""
+        return self.hosts[vehicle.name].address
+
+    def uses_tcp(self, vehicle: Vehicle) -> bool:
+        return self.split_usv and vehicle.kind == "usv"
+
+    def environment(self, launcher: str) -> dict[str, str]:
+        """The TRAIL_* variables that put a launcher's configs on its host: links, pages and MOOSDB on the host's
+        address, links accepting only the hosts' subnet, and for the two-computer USV the TCP broker."""
+        host = self.hosts[launcher]
+        vehicle_host = self.hosts["usv"] if launcher == USV_FRONTSEAT else host
+        env = {"TRAIL_LINK_ADDRESS": host.address, "TRAIL_LIAISON_ADDRESS": host.address,
+               "TRAIL_MOOS_ADDRESS": vehicle_host.address, "TRAIL_LINK_PEERS": self.peers}
+        if self.split_usv and launcher in ("usv", USV_FRONTSEAT):
+            env |= {"TRAIL_BROKER_ADDRESS": vehicle_host.address, "TRAIL_BROKER_PORT": str(self.broker_port)}
+        return env
+
+    def interprocess(self, vehicle: Vehicle, settings: TrailSettings) -> InterProcessPortalConfig:
+        """How the demo's portal threads reach the vehicle's broker: its IPC socket (the filesystem is shared
+        across namespaces), or TCP to the two-computer USV's backseat."""
+        cfg = InterProcessPortalConfig(platform=vehicle.name, manager_timeout_seconds=30)
+        if self.uses_tcp(vehicle):
+            cfg.transport = InterProcessPortalConfig.TCP
+            cfg.ipv4_address = self.address(vehicle)
+            cfg.tcp_port = self.broker_port
+        else:
+            cfg.socket_name = vehicle.ipc_base(settings)
+        return cfg
+
+
+def hosts_launch_entries(n_auvs: int, plan: HostPlan) -> list[LaunchEntry]:
+    """all.launch with each platform's goby-launch started inside its host (``ip netns exec``) with that host's
+    variables; with ``split_usv`` the USV is usv_backseat.launch and usv_frontseat.launch on two hosts."""
+    entries = []
+    for entry in all_launch_entries(n_auvs):
+        name = entry.name or ""
+        parts = [(name, entry.command)]
+        if plan.split_usv and name == "usv":
+            back = entry.command.replace("/usv.launch", "/usv_backseat.launch").replace(" -d 100 ", " -d 100 -p usv ")
+            front = back.replace("/usv_backseat.launch", "/usv_frontseat.launch").replace(" -p usv ",
+                                                                                        f" -p {USV_FRONTSEAT} ")
+            parts = [(name, back), (USV_FRONTSEAT, front)]
+        for launcher, command in parts:
+            host = plan.hosts[launcher]
+            env = entry.env + tuple(plan.environment(launcher).items())
+            entries.append(dataclasses.replace(entry, name=launcher, command=host.shell_prefix + command, env=env))
+    return entries
+
+
+class AddressedMoosRecorder(MoosRecorder):
+    """A MoosRecorder of a MOOSDB on another host (``MoosRecorder`` connects to 127.0.0.1)."""
+
+    def __init__(self, record: MissionRecord, clock: SimClock, address: str, moos_port: int, name: str,
+                 variables: tuple[str, ...] | None) -> None:
+        super().__init__(record, clock, moos_port, name=name, variables=variables)
+        self.address = address
+
+    def start(self) -> None:
+        self.comms.run(self.address, self.moos_port, self.name)
+
+
+def use_interprocess(thread: BackgroundPortalThread, cfg: InterProcessPortalConfig) -> None:
+    """Point a demo portal thread (PortalRecorder, PortalWorker: built with an IPC base) at ``cfg`` before it
+    starts. TODO(lead): an ``interprocess`` argument of those classes would replace this."""
+    thread._cfg.interprocess.CopyFrom(cfg)  # type: ignore[attr-defined]
+
+
+def _tcp_open(address: str, port: int) -> bool:
+    try:
+        with socket.create_connection((address, port), timeout=1.0):
+            return True
+    except OSError:
+        return False
 
 
 @dataclass
@@ -99,10 +204,13 @@ class TrailMission:
         platform: str = "trail",
         keep_going: bool = False,
         moos_variables: tuple[str, ...] | None = None,
+        hosts: HostPlan | None = None,
     ) -> None:
         self.settings = settings
         self.n_auvs = n_auvs
-        self.entries = list(entries) if entries is not None else all_launch_entries(n_auvs)
+        self.hosts = hosts  # one platform per host (docs/hosts.md); None: all on this machine
+        self.entries = list(entries) if entries is not None else (
+            all_launch_entries(n_auvs) if hosts is None else hosts_launch_entries(n_auvs, hosts))
         self.extra_env = dict(extra_env or {})
         self.report = report
         self.launch_delay_s = launch_delay_s
@@ -149,8 +257,11 @@ class TrailMission:
         self.group.stop_event = self.stop_event
         for run in self.runs.values():
             if run.vehicle.kind != "topside":
-                run.moos = MoosRecorder(run.record, self.clock, run.vehicle.moos_port(self.settings),
-                                        name=f"uTrailRecorder_{run.vehicle.name}", variables=self.moos_variables)
+                name, port = f"uTrailRecorder_{run.vehicle.name}", run.vehicle.moos_port(self.settings)
+                run.moos = (MoosRecorder(run.record, self.clock, port, name=name, variables=self.moos_variables)
+                            if self.hosts is None else
+                            AddressedMoosRecorder(run.record, self.clock, self.hosts.address(run.vehicle), port, name,
+                                                  self.moos_variables))
                 run.moos.start()
         self.group.on_wait = self.poll_moos
         self.group.start()
@@ -159,13 +270,21 @@ class TrailMission:
         for run in self.runs.values():
             if run.vehicle.kind != "topside":
                 run.portal = PortalRecorder(run.record, self.clock, run.vehicle.name, run.vehicle.ipc_base(self.settings))
+                if self.hosts is not None:
+                    use_interprocess(run.portal, self.hosts.interprocess(run.vehicle, self.settings))
                 run.portal.start()
 
     def wait_for_brokers(self, timeout_s: float = 120.0) -> None:
         """Block until every recorded vehicle's broker has its manager socket (portal clients time out otherwise)."""
         deadline = time.monotonic() + timeout_s
-        sockets = {name: Path(ipc_manager_path(run.vehicle.ipc_base(self.settings))) for name, run in self.runs.items()}
-        while missing := [name for name, path in sockets.items() if not path.exists()]:
+        hosts = self.hosts
+
+        def up(run: VehicleRun) -> bool:
+            if hosts is not None and hosts.uses_tcp(run.vehicle):
+                return _tcp_open(hosts.address(run.vehicle), hosts.broker_port)
+            return Path(ipc_manager_path(run.vehicle.ipc_base(self.settings))).exists()
+
+        while missing := [name for name, run in self.runs.items() if not up(run)]:
             if self.stop_event.is_set():
                 return
             self.poll()

@@ -58,7 +58,8 @@ _ENV = env_variables("TRAIL_", (
     "run_dir", "warp", "lat_origin", "lon_origin", "moos_port_base", "sim_port_base", "liaison_port_base",
     "satellite_port", "acomms_port", "moosdb", "helm", "usv_helm", "liaison_address", "link_address", "schedule",
     "socket_dir",
-    "east_duration", "south_duration", "acomms_channel", "satellite_channel"))
+    "east_duration", "south_duration", "acomms_channel", "satellite_channel", "moos_address", "broker_address",
+    "broker_port", "link_peers"))
 CHANNEL_LINKS = ("satellite", "acomms")
 
 
@@ -90,6 +91,16 @@ class TrailSettings(EnvSettings):
     south_duration: int = 200
     acomms_channel: str = ""  # channel_model text for the acoustic link ("": lossless)
     satellite_channel: str = ""  # ... for the satellite link
+    # One platform per host (docs/hosts.md): where the MOOSDB listens and the MOOS apps connect (loopback on one
+    # machine; the host's address when another computer of the vehicle, or the demo's console, reaches it) ...
+    moos_address: str = "127.0.0.1"
+    # ... the interprocess transport: "" IPC (socket_dir), else Goby's TCP transport, the broker binding this
+    # address and port and every app of the vehicle connecting there (a vehicle of two computers)
+    broker_address: str = ""
+    broker_port: int = 11144  # Goby's default tcp_port
+    # ... and the sources the links accept (our udp_peers extension): comma-separated addresses or networks of
+    # the peers' computers ("": any on a host address, loopback only on 127.0.0.1)
+    link_peers: str = ""
 
     def __post_init__(self) -> None:
         check_warp_and_origin(self.warp, self.lat_origin, self.lon_origin)
@@ -97,10 +108,14 @@ class TrailSettings(EnvSettings):
             self.channel_model(link)  # a bad one is a MissionConfigError naming the variable and the field
         if self.usv_helm not in ("ivp", "goby"):
             raise MissionConfigError(f"TRAIL_USV_HELM must be ivp or goby, not {self.usv_helm!r}")
-        try:
-            ipaddress.IPv4Address(self.link_address)
-        except ValueError:
-            raise MissionConfigError(f"TRAIL_LINK_ADDRESS must be an IPv4 address, not {self.link_address!r}") from None
+        for name in ("link_address", "moos_address", *(("broker_address",) if self.broker_address else ())):
+            try:
+                ipaddress.IPv4Address(getattr(self, name))
+            except ValueError:
+                raise MissionConfigError(f"{_ENV[name]} must be an IPv4 address, not {getattr(self, name)!r}") from None
+        self.peer_networks()
+        if not 0 < self.broker_port < 65536:
+            raise MissionConfigError(f"TRAIL_BROKER_PORT {self.broker_port} is not a TCP port")
         for name in ("moos_port_base", "sim_port_base", "liaison_port_base", "satellite_port", "acomms_port"):
             port = getattr(self, name)
             if not 0 < port < 65536 - 256:
@@ -119,6 +134,16 @@ class TrailSettings(EnvSettings):
         except (text_format.ParseError, ModemConfigError) as exc:
             raise MissionConfigError(f"{var}={text!r}: {exc}") from None
         return model
+
+    def peer_networks(self) -> list[str]:
+        """``link_peers`` as networks (an address is its /32); MissionConfigError naming a bad one."""
+        out = []
+        for text in filter(None, (part.strip() for part in self.link_peers.split(","))):
+            try:
+                out.append(str(ipaddress.IPv4Network(text, strict=False)))
+            except ValueError:
+                raise MissionConfigError(f"TRAIL_LINK_PEERS: {text!r} is not an IPv4 address or network") from None
+        return out
 
     @property
     def sockets(self) -> Path:
