@@ -18,7 +18,7 @@ from typing import Any, Generic, TypeVar
 
 from google.protobuf import descriptor as pb_descriptor
 from google.protobuf import message as pb_message
-from google.protobuf import text_format
+from google.protobuf import text_encoding, text_format
 
 from gateway.goby.portal.errors import AppConfigError
 from gateway.goby.protobuf.app_config_pb2 import AppConfig
@@ -286,10 +286,8 @@ def _example_value(field: pb_descriptor.FieldDescriptor) -> str:
         value = {_FD.TYPE_STRING: "", _FD.TYPE_BYTES: b""}.get(field.type, 0)
     if field.type == _FD.TYPE_BOOL:
         return "true" if value else "false"
-    if field.type == _FD.TYPE_STRING:
-        return '"' + str(value).replace('"', '\\"') + '"'
-    if field.type == _FD.TYPE_BYTES:
-        return '"' + value.decode(errors="replace") + '"'
+    if field.type in (_FD.TYPE_STRING, _FD.TYPE_BYTES):  # escaped as text format reads it (a newline as \n)
+        return '"' + text_encoding.CEscape(value, as_utf8=field.type == _FD.TYPE_STRING) + '"'
     return repr(value) if isinstance(value, float) else str(value)
 
 
