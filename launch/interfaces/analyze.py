@@ -12,8 +12,9 @@ names the file and line, so an interface file can never silently miss a call.
 What the process runs besides its own modules is followed as goby_clang_tool follows template instantiations:
 a thread class given to ``launch_thread`` (a class, or the result of a lookup annotated ``-> type[...]`` such as
 an extension point's, which only imports) has its module analysed too; and every application class
-(``SingleThreadApplication``/``MultiThreadApplication``) publishes its configuration on ``goby::configuration``,
-as Goby's application base classes do.
+(``SingleThreadApplication``/``MultiThreadApplication``) publishes its configuration on ``goby::configuration``
+and answers health and terminate requests (``goby::health::*``, ``goby::terminate::*``), as Goby's application base
+classes do.
 """
 
 from __future__ import annotations
@@ -41,6 +42,19 @@ LAYER_METHODS = {"interprocess": "interprocess", "interthread": "interthread", "
 
 
 CONFIGURATION_GROUP = "goby::configuration"
+
+
+def _base_class_calls() -> list[tuple[str, type, str]]:
+    """What every application's base class subscribes and publishes besides its configuration (as in Goby's files):
+    the health answer (gateway/goby/portal/health.py) and the terminate answer (terminate.py)."""
+    from gateway.goby.portal.health import HEALTH_REQUEST, HEALTH_RESPONSE
+    from gateway.goby.portal.protobuf.coroner_pb2 import HealthRequest, ProcessHealth
+    from gateway.goby.portal.protobuf.terminate_pb2 import TerminateRequest, TerminateResponse
+    from gateway.goby.portal.terminate import TERMINATE_REQUEST, TERMINATE_RESPONSE
+
+    return [(str(HEALTH_REQUEST), HealthRequest, "subscribes"), (str(HEALTH_RESPONSE), ProcessHealth, "publishes"),
+            (str(TERMINATE_REQUEST), TerminateRequest, "subscribes"),
+            (str(TERMINATE_RESPONSE), TerminateResponse, "publishes")]
 
 
 class AnalysisError(LaunchError):
@@ -229,7 +243,12 @@ class _ModuleAnalyzer(ast.NodeVisitor):
         )
 
     def _callee(self, func: ast.expr, node: ast.AST) -> object:
-        """The function a call invokes; ``obj.method`` on a local of known class resolves through the class."""
+        """The function a call invokes; ``obj.method`` on a local of known class resolves through the class, and
+        ``self.method`` through the enclosing class."""
+        if isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name) and func.value.id == "self":
+            owner = getattr(self.module, self.class_stack[-1].name, None) if self.class_stack else None
+            if isinstance(owner, type) and hasattr(owner, func.attr):
+                return getattr(owner, func.attr)
         if isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name):
             types = _FunctionTypes(self.func_stack[-1] if self.func_stack else None)
             origin = types.origins.get(func.value.id)
@@ -307,6 +326,9 @@ class _ModuleAnalyzer(ast.NodeVisitor):
         self._note_thread(thread)
         self.interface.add(PubSubEntry("interprocess", thread, CONFIGURATION_GROUP, "PROTOBUF",
                                        cxx_type_name(config_type), "publishes"))
+        for group, message_type, direction in _base_class_calls():
+            self.interface.add(PubSubEntry("interprocess", thread, group, "PROTOBUF", cxx_type_name(message_type),
+                                           direction))
 
     def _launched_class(self, expr: ast.expr, node: ast.AST) -> type:
         """The class a ``launch_thread`` call starts: a class expression, or a local set by a class lookup."""

@@ -16,6 +16,8 @@ SHIPPED_APPLICATIONS: dict[str, list[str]] = {
     "usv-command": ["translators.apps.usv_command"],
     "auv-manager": ["translators.apps.auv_manager", "translators.trail.auv_manager"],
     "topside-manager": ["translators.apps.topside_manager", "translators.trail.topside_manager"],
+    "usv-health-monitor": ["translators.apps.usv_health_monitor"],
+    "goby-coroner": ["gateway.apps.goby_coroner"],
     "moos-gateway-frontseat-plugin": ["translators.frontseat.translation"],
     "moos-gateway-usv-command-plugin": ["translators.usv.command_translation"],
     "moos-gateway-node-report-plugin": ["translators.node_report"],

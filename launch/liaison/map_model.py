@@ -1,4 +1,5 @@
-"""The live map's state: vehicles from NodeStatus (position, heading, trail) and the mission's overlays.
+"""The live map's state: vehicles from NodeStatus (position, heading, trail), the mission's overlays, and the
+vehicle's last health (the course's HealthStatus, as topside-manager publishes it from the satellite link).
 
 Threads: :meth:`MapModel.ingest_node_status` and :meth:`ingest_command` run on the portal thread and only keep the
 newest payload (under a lock held for microseconds); :meth:`tick` decodes them on the web thread, once per update
@@ -17,13 +18,16 @@ from __future__ import annotations
 import logging
 import math
 import threading
+import time
 from collections import Counter, deque
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus, VehicleType
 from launch.liaison.form_schema import dccl_bounds
 from launch.usv.geometry import radial_polygon
+from translators.trail.protobuf.health_status_pb2 import HealthStatus
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from util.ratelimit import RateLimitedLog
 
@@ -31,6 +35,8 @@ log = logging.getLogger(__name__)
 
 NODE_STATUS_TYPE = NodeStatus.DESCRIPTOR.full_name
 USV_COMMAND_TYPE = USVCommand.DESCRIPTOR.full_name
+HEALTH_STATUS_TYPE = HealthStatus.DESCRIPTOR.full_name
+HEALTH_RESEND_S = 1.0  # real seconds between updates of the health rows' ages when nothing new arrived
 Point = tuple[float, float]
 TRAIL_SPACING_M = 5.0  # a trail point is kept once the vehicle has moved this far from the last one
 MAX_VEHICLES = 256  # vehicles drawn; NodeStatus of further names is counted and dropped
@@ -72,11 +78,24 @@ class _Vehicle:
         return out
 
 
+@dataclass(eq=False)
+class _Health:
+    """A vehicle's last HealthStatus and when (this page's clock, sim s) it arrived."""
+
+    state: str
+    timestamp: float  # the status's own time, s (time2: only the second of the day travels the link)
+    received: float
+
+    def view(self, vehicle: str, now: float) -> dict[str, Any]:
+        return {"vehicle": vehicle, "state": self.state, "time_of_day": round(self.timestamp % 86400.0),
+                "age": max(0, round(now - self.received))}
+
+
 class MapModel:
     """Vehicles by name, the waypoint track and the loiter polygon (from the config, moved by USV commands)."""
 
     def __init__(self, waypoints: list[Point], polygon: list[Point], center_activate: bool = False,
-                 trail_points: int = 600) -> None:
+                 trail_points: int = 600, clock_now: Callable[[], float] = time.time) -> None:
         self.waypoints = list(waypoints)
         self.polygon = list(polygon)
         self.mode: str | None = None
@@ -85,6 +104,10 @@ class MapModel:
         self._lock = threading.Lock()
         self._node_payloads: dict[str, bytes] = {}
         self._command_payload: bytes | None = None
+        self._health_payload: tuple[bytes, float] | None = None
+        self._health: dict[str, _Health] = {}
+        self._health_sent = 0.0  # time.monotonic() of the last health rows sent
+        self._now = clock_now
         self._vehicles: dict[str, _Vehicle] = {}
         self._last_command_time: float | None = None
         self._overlay_changed = True
@@ -107,12 +130,21 @@ class MapModel:
         with self._lock:
             self._command_payload = payload
 
+    def ingest_health(self, payload: bytes) -> None:
+        """Keep the newest HealthStatus, with its arrival time. Runs on the portal thread."""
+        received = self._now()
+        with self._lock:
+            self._health_payload = (payload, received)
+
     # ------------------------------------------------------------------------------------- web thread
     def tick(self) -> dict[str, Any] | None:
         """Decode what arrived since the last tick; the changes as a view, or None. Web thread."""
         with self._lock:
             nodes, self._node_payloads = self._node_payloads, {}
             command, self._command_payload = self._command_payload, None
+            health, self._health_payload = self._health_payload, None
+        health_changed = health is not None and self._update_health(*health)
+        health_due = bool(self._health) and time.monotonic() - self._health_sent >= HEALTH_RESEND_S
         changed = []
         for group, payload in nodes.items():
             vehicle = self._update_vehicle(group, payload)
@@ -123,9 +155,11 @@ class MapModel:
         if not self._centred and self._usv() is not None:
             self._centre_polygon()
             self._centred = True
-        if not changed and not self._overlay_changed:
+        if not changed and not self._overlay_changed and not health_changed and not health_due:
             return None
         update: dict[str, Any] = {"vehicles": [v.view(full=False) for v in changed]}
+        if health_changed or health_due:
+            update["health"] = self._health_view()
         for vehicle in changed:
             vehicle.appended.clear()
         if self._overlay_changed:
@@ -135,7 +169,30 @@ class MapModel:
 
     def snapshot(self) -> dict[str, Any]:
         """Everything, trails included, for a page that just connected. Web thread."""
-        return {"vehicles": [v.view(full=True) for v in self._vehicles.values()], **self._overlays()}
+        return {"vehicles": [v.view(full=True) for v in self._vehicles.values()], **self._overlays(),
+                "health": self._health_view()}
+
+    def _health_view(self) -> list[dict[str, Any]]:
+        self._health_sent = time.monotonic()
+        now = self._now()
+        return [health.view(vehicle, now) for vehicle, health in self._health.items()]
+
+    def _update_health(self, payload: bytes, received: float) -> bool:
+        """Store a HealthStatus as the USV's (it carries no vehicle; in the course only the USV reports it, over
+        the satellite link, so it is the USV's on the map, or ``USV`` before its first NodeStatus)."""
+        status = HealthStatus()
+        try:
+            status.ParseFromString(payload)
+        except Exception as exc:  # noqa: BLE001 - bad input from the broker: report, keep serving
+            self._refuse("unparsable", "HealthStatus does not parse: %s", exc)
+            return False
+        if not status.HasField("state") or status.state not in HealthStatus.HealthState.values():
+            self._refuse("health-state", "HealthStatus without a known state: dropped")
+            return False
+        usv = self._usv()
+        self._health[usv.name if usv is not None else "USV"] = _Health(
+            HealthStatus.HealthState.Name(status.state), status.timestamp / 1e6, received)
+        return True
 
     def _overlays(self) -> dict[str, Any]:
         return {"waypoints": [list(p) for p in self.waypoints], "polygon": [list(p) for p in self.polygon],

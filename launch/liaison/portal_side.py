@@ -22,7 +22,7 @@ from gateway.goby.portal.marshalling import Scheme
 from gateway.goby.protobuf.layer_pb2 import LAYER_INTERTHREAD, LAYER_INTERVEHICLE
 from launch.liaison.commander_model import CommanderModel, CommandType, Target
 from launch.liaison.errors import LiaisonError
-from launch.liaison.map_model import NODE_STATUS_TYPE, USV_COMMAND_TYPE, MapModel
+from launch.liaison.map_model import HEALTH_STATUS_TYPE, NODE_STATUS_TYPE, USV_COMMAND_TYPE, MapModel
 from launch.liaison.message_types import find_message_type
 from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
 from launch.liaison.protobuf.liaison_web_pb2 import InterProcessAck
@@ -46,9 +46,9 @@ class LiaisonApp(SingleThreadApplication):
         super().__init__(cfg, loop_frequency_hz=1.0)
         self.settings = s
         self.scope = ScopeModel(s.max_history, s.max_rows, s.max_message_size)
-        self.map = MapModel(s.waypoints, s.polygon, s.center_activate, s.trail_points)
-        self.commander = CommanderModel(s.command_types, s.command_history)
         clock = self.context.clock
+        self.map = MapModel(s.waypoints, s.polygon, s.center_activate, s.trail_points, clock.now)
+        self.commander = CommanderModel(s.command_types, s.command_history)
         self.web = WebServer(s, self.scope, self.commander, self.map, self._hand_over, clock.now)
         portal = self.interprocess()
         portal.subscribe_regex(self._on_publication, ".*", ".*", (Scheme.ALL_SCHEMES,))
@@ -73,6 +73,8 @@ class LiaisonApp(SingleThreadApplication):
                 self.map.ingest_node_status(group, payload)
             elif type_name == USV_COMMAND_TYPE:
                 self.map.ingest_command(payload)
+            elif type_name == HEALTH_STATUS_TYPE:
+                self.map.ingest_health(payload)
 
     def _subscribe_ack(self, rule: InterProcessAck) -> None:
         ack_cls = find_message_type(rule.ack_type)

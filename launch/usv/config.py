@@ -84,6 +84,13 @@ def _vehicle_interprocess(settings: UsvSettings) -> str:
                     .replace("interprocess {", "").replace("}", "").split())
 
 
+def _topside_manager(settings: UsvSettings) -> str:
+    """topside-manager on the topside's broker: the USV's nav and health from its satellite modem."""
+    values = _topside_values(settings, "topside-manager")
+    values["usv_modem_id"] = USV_MODEM_ID
+    return render(TEMPLATES / "topside_manager.pb.cfg.in", values)
+
+
 def _liaison(settings: UsvSettings) -> str:
     """goby-liaison's config: the course's liaison.pb.cfg.in with our commander target (Goby3's fields only)."""
     return render(TEMPLATES / "liaison.pb.cfg.in", _values(settings, "goby-liaison"))
@@ -139,6 +146,9 @@ GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
     "frontseat_tuning": _pb("frontseat_tuning.pb.cfg.in", "frontseat-interface"),
     "moos_gateway": _pb("moos_gateway.pb.cfg.in", "moos-gateway"),
     "usv_manager": _pb("usv_manager.pb.cfg.in", "usv-manager"),
+    "goby_coroner": _pb("goby_coroner.pb.cfg.in", "goby-coroner"),
+    "usv_health_monitor": _pb("usv_health_monitor.pb.cfg.in", "usv-health-monitor"),
+    "topside_manager": _topside_manager,
     "topside_broker": _topside("broker.pb.cfg.in", "goby-broker"),
     "shore": _topside("shore.pb.cfg.in", "usv-shore"),
     "usv_command": _topside("shore.pb.cfg.in", "usv-command"),  # for sending commands by hand

@@ -27,8 +27,12 @@ ORIGINAL_FRONTSEAT_INTERFACE = (
     | {("subscribes", "goby::datum_update", "goby::middleware::protobuf::DatumUpdate")}
     | _frontseat("publishes", "command_response:CommandResponse", "data_from_frontseat:InterfaceData",
                  "node_status:NodeStatus", "raw_in:Raw", "raw_out:Raw", "status:InterfaceStatus")
-    # Goby's application base class announces the configuration at start
+    # Goby's application base class announces the configuration at start, and answers health and terminate requests
     | {("publishes", "goby::configuration", "goby::apps::zeromq::protobuf::FrontSeatInterfaceConfig")}
+    | {("subscribes", "goby::health::request", "goby::middleware::protobuf::HealthRequest"),
+       ("publishes", "goby::health::response", "goby::middleware::protobuf::ProcessHealth"),
+       ("subscribes", "goby::terminate::request", "goby::middleware::protobuf::TerminateRequest"),
+       ("publishes", "goby::terminate::response", "goby::middleware::protobuf::TerminateResponse")}
 )
 # The embedded FrontSeatTranslation (the moos_helm block; Goby's interface file lists it in goby_frontseat_interface
 # too): Goby3's frontseat_gateway_plugin.h/.cpp subscribe node_status and publish helm_state and desired_course;
@@ -72,3 +76,5 @@ def test_usv_deployment_has_the_edges_the_mission_needs() -> None:
     assert ("usv-manager", "moos-gateway", "goby3_course::usv_command;0") in edges
     assert ("usv-command", "usv-manager", "goby3_course::shore::usv_command;0") in edges
     assert ("moos-gateway", "usv-command", "goby3_course::usv_command_ack") in edges
+    # the health chain: goby-coroner's report to usv-health-monitor (docs/health.md)
+    assert ("goby-coroner", "usv-health-monitor", "goby::health::report") in edges

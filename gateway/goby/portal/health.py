@@ -9,9 +9,9 @@ first.  A thread that has not answered by then stays as preseeded: ``HEALTH__FAI
 ``ERROR__THREAD_NOT_RESPONDING``, and the process's state is the worst of its threads.  Everything here runs on the
 application's main thread (the probes on each launched thread); the window is a timer on the main reactor.
 
-These calls are made by the application base classes, not by the application's own code, so they are not recorded
-in the interface registry (``record=False``; the same for terminate.py): the interface files, derived from the
-applications' source, do not list them yet.
+These calls are made by the application base classes, not by the application's own code; they are recorded in the
+interface registry like any other (the same for terminate.py), and the interface analysis lists them for every
+application class (launch/interfaces/analyze.py), as Goby's interface files do.
 """
 
 from __future__ import annotations
@@ -59,10 +59,9 @@ def answer_at_once(app: SimpleThread, app_name: Callable[[], str]) -> None:
     """Subscribe ``app`` (a single-thread application, on its main thread) to answer health requests directly."""
 
     def on_request(_request: HealthRequest) -> None:
-        app.interprocess().publish(HEALTH_RESPONSE, process_health(app_name(), app.thread_health()),
-                                   record=False)
+        app.interprocess().publish(HEALTH_RESPONSE, process_health(app_name(), app.thread_health()))
 
-    app.interprocess().subscribe(HEALTH_REQUEST, HealthRequest, on_request, record=False)
+    app.interprocess().subscribe(HEALTH_REQUEST, HealthRequest, on_request)
 
 
 class ThreadHealthCollector:
@@ -81,7 +80,7 @@ class ThreadHealthCollector:
         self._pending: ProcessHealth | None = None
         self._waiting: set[int] = set()
         self._timer: Timer | None = None
-        app.interprocess().subscribe(HEALTH_REQUEST, HealthRequest, self._on_request, record=False)
+        app.interprocess().subscribe(HEALTH_REQUEST, HealthRequest, self._on_request)
 
     def _on_request(self, _request: HealthRequest) -> None:
         if self._pending is not None:
@@ -136,4 +135,4 @@ class ThreadHealthCollector:
                         ", ".join(c.name for c in answer.main.child if c.uid in self._waiting))
         worst = max([answer.main.state, *(c.state for c in answer.main.child)])
         answer.main.state = worst
-        self._app.interprocess().publish(HEALTH_RESPONSE, answer, record=False)
+        self._app.interprocess().publish(HEALTH_RESPONSE, answer)

@@ -43,7 +43,7 @@ def subscribe_terminate(app: SimpleThread, app_name: Callable[[], str], quit_app
         match, response = check_terminate(request, app_name())
         if match:
             log.info("goby-terminate asked %s (pid %d) to quit", response.target_name, response.target_pid)
-            app.interprocess().publish(TERMINATE_RESPONSE, response, record=False)
+            app.interprocess().publish(TERMINATE_RESPONSE, response)
             quit_app()
 
-    app.interprocess().subscribe(TERMINATE_REQUEST, TerminateRequest, on_request, record=False)
+    app.interprocess().subscribe(TERMINATE_REQUEST, TerminateRequest, on_request)

@@ -18,6 +18,22 @@ const LiveMap = {
     }
     if (msg.waypoints !== undefined) this.setOverlays(msg);
     for (const data of msg.vehicles || []) this.updateVehicle(data, msg.full);
+    if (msg.health !== undefined) this.setHealth(msg.health);
+  },
+
+  // Each vehicle's last HealthStatus: state, its time of day (time2 carries only that), age since it arrived (sim s).
+  setHealth(rows) {
+    const clock = (s) => [Math.floor(s / 3600), Math.floor(s / 60) % 60, s % 60].map((n) => String(n).padStart(2, "0")).join(":");
+    document.querySelector("#health-table tbody").replaceChildren(...rows.map((h) => {
+      const row = el("tr", {"data-vehicle": h.vehicle});
+      for (const text of [h.vehicle, h.state, clock(h.time_of_day), String(h.age)]) {
+        const cell = el("td");
+        cell.textContent = text;
+        row.append(cell);
+      }
+      row.children[1].className = h.state === "GOOD" ? "state-acknowledged" : "state-failed";
+      return row;
+    }));
   },
 
   setOverlays(msg) {
