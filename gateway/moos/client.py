@@ -182,6 +182,13 @@ class comms(ClientEngine):  # noqa: N801 - pymoos's class name
             return self._post_fields(NOTIFY, STRING, key, aux, time, -1.0, raw)
         return self._post_fields(NOTIFY, DOUBLE, key, aux, time, float(value), b"")  # bool, numpy, Decimal...
 
+    def post(self, msg: MoosMessage, keep_source: bool = False) -> bool:
+        """Publish a whole message (name, value, time, aux source); with ``keep_source`` under its own source, not
+        ours. Our extension, libMOOS's ``Post(msg, bKeepMsgSourceName)``: what pShare does with what it receives."""
+        self._published.add(msg.key())
+        return self._post_fields(msg.msg_type, msg.data_type, msg.raw_key, msg.raw_aux, msg.msg_time, msg.dval,
+                                 msg.raw_sval, src=msg.raw_src if keep_source else None)
+
     def notify_binary(self, name: str, binary_data: bytes | str, time: float = -1.0) -> bool:
         """Publish raw bytes as a BINARY message (the only way to send arbitrary bytes, including NUL)."""
         if time == -1.0:

@@ -546,9 +546,10 @@ class ClientEngine:
 
     def _post_fields(
         self, msg_type: bytes, data_type: bytes, key: bytes, aux: bytes, msg_time: float, dval: float,
-        sval: bytes, msg_id: int | None = None,
+        sval: bytes, msg_id: int | None = None, src: bytes | None = None,
     ) -> bool:
-        """Encode a message at once and get it written: directly if the link is idle, else by the reactor."""
+        """Encode a message at once and get it written: directly if the link is idle, else by the reactor.
+        ``src``: the source to send (default: our name)."""
         on_io = self._on_io_thread()
         if on_io and len(self._outbox) >= self._outbox_limit and self._writable:
             # the reactor cannot wait for itself: write out until there is room (the link's own back-pressure)
@@ -563,8 +564,8 @@ class ClientEngine:
                 self._next_id += 1
             if not on_io and len(self._outbox) >= self._outbox_limit:
                 self._wait_for_space()
-            wire = encode_fields(msg_type, data_type, msg_id, self._src, aux, self._com, key, msg_time, dval, -1.0,
-                                 sval)
+            wire = encode_fields(msg_type, data_type, msg_id, self._src if src is None else src, aux, self._com, key,
+                                 msg_time, dval, -1.0, sval)
             self._outbox.append(wire)
             self._outbox_bytes += len(wire)
             if not self._writable or self._flush_scheduled or self._writing or self._pending is not None:
