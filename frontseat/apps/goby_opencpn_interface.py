@@ -28,13 +28,10 @@ from dataclasses import dataclass, field
 
 from frontseat.groups import node_status
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
-from frontseat.protobuf.opencpn_config_pb2 import (
-    OpenCPNInterfaceConfig,
-    OpenCPNPTYConfig,
-    OpenCPNTCPServerConfig,
-)
+from frontseat.protobuf.opencpn_config_pb2 import OpenCPNInterfaceConfig
 from gateway.goby.ais import AISConverter, AISError, AISFleet
 from gateway.goby.portal import SingleThreadApplication, StartError, run_application
+from gateway.goby.protobuf.io_config_pb2 import PTYConfig, TCPServerConfig
 from util.reactor import Reactor
 from util.sockets import accept_client
 
@@ -54,7 +51,7 @@ class _Client:
 class SentenceServer:
     """A TCP server on ``reactor`` that writes the same bytes to every connected client (Goby's ``all_clients``)."""
 
-    def __init__(self, reactor: Reactor, cfg: OpenCPNTCPServerConfig) -> None:
+    def __init__(self, reactor: Reactor, cfg: TCPServerConfig) -> None:
         self._reactor = reactor
         self._clients: dict[socket.socket, _Client] = {}
         family = socket.AF_INET6 if cfg.ipv6 else socket.AF_INET
@@ -144,7 +141,7 @@ class SentencePty:
     When nothing reads the device the terminal's buffer fills: then the oldest unsent bytes beyond ``MAX_BACKLOG``
     are discarded (logged), never blocking the reactor."""
 
-    def __init__(self, reactor: Reactor, cfg: OpenCPNPTYConfig) -> None:
+    def __init__(self, reactor: Reactor, cfg: PTYConfig) -> None:
         self._reactor = reactor
         self._link = cfg.port
         self._outbuf = bytearray()

@@ -24,19 +24,16 @@ _sym_db = _symbol_database.Default()
 
 from gateway.goby.protobuf import app_config_pb2 as gateway_dot_goby_dot_protobuf_dot_app__config__pb2
 from gateway.goby.protobuf import interprocess_config_pb2 as gateway_dot_goby_dot_protobuf_dot_interprocess__config__pb2
+from gateway.goby.protobuf import io_config_pb2 as gateway_dot_goby_dot_protobuf_dot_io__config__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\'frontseat/protobuf/opencpn_config.proto\x12\x19goby.apps.zeromq.protobuf\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\"\x97\x01\n\x16OpenCPNTCPServerConfig\x12\x11\n\tbind_port\x18\x02 \x02(\r\x12\x16\n\x0b\x65nd_of_line\x18\x03 \x01(\t:\x01\n\x12\x1c\n\rset_reuseaddr\x18\n \x01(\x08:\x05\x66\x61lse\x12\x13\n\x04ipv6\x18\x0b \x01(\x08:\x05\x66\x61lse\x12\x1f\n\x0c\x62ind_address\x18\x64 \x01(\t:\t127.0.0.1\"N\n\x10OpenCPNPTYConfig\x12\x0c\n\x04port\x18\x01 \x02(\t\x12\x14\n\x04\x62\x61ud\x18\x02 \x01(\r:\x06\x31\x31\x35\x32\x30\x30\x12\x16\n\x0b\x65nd_of_line\x18\x03 \x01(\t:\x01\n\"\xa4\x03\n\x16OpenCPNInterfaceConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12G\n\nais_server\x18\x05 \x01(\x0b\x32\x31.goby.apps.zeromq.protobuf.OpenCPNTCPServerConfigH\x00\x12\x41\n\nais_serial\x18\x06 \x01(\x0b\x32+.goby.apps.zeromq.protobuf.OpenCPNPTYConfigH\x00\x12\x1d\n\nmmsi_start\x18\n \x01(\x05:\t988700000\x12\x18\n\rfilter_length\x18\x0b \x01(\x05:\x01\x32\x12#\n\x18position_report_interval\x18\x0c \x01(\x01:\x01\x31\x12\"\n\x16voyage_report_interval\x18\r \x01(\x01:\x02\x33\x30\x42\x04\n\x02io')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\'frontseat/protobuf/opencpn_config.proto\x12\x19goby.apps.zeromq.protobuf\x1a&gateway/goby/protobuf/app_config.proto\x1a/gateway/goby/protobuf/interprocess_config.proto\x1a%gateway/goby/protobuf/io_config.proto\"\x94\x03\n\x16OpenCPNInterfaceConfig\x12\x30\n\x03\x61pp\x18\x01 \x01(\x0b\x32#.goby.middleware.protobuf.AppConfig\x12\x44\n\x0cinterprocess\x18\x02 \x01(\x0b\x32..goby.zeromq.protobuf.InterProcessPortalConfig\x12?\n\nais_server\x18\x05 \x01(\x0b\x32).goby.middleware.protobuf.TCPServerConfigH\x00\x12\x39\n\nais_serial\x18\x06 \x01(\x0b\x32#.goby.middleware.protobuf.PTYConfigH\x00\x12\x1d\n\nmmsi_start\x18\n \x01(\x05:\t988700000\x12\x18\n\rfilter_length\x18\x0b \x01(\x05:\x01\x32\x12#\n\x18position_report_interval\x18\x0c \x01(\x01:\x01\x31\x12\"\n\x16voyage_report_interval\x18\r \x01(\x01:\x02\x33\x30\x42\x04\n\x02io')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'frontseat.protobuf.opencpn_config_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_OPENCPNTCPSERVERCONFIG']._serialized_start=160
-  _globals['_OPENCPNTCPSERVERCONFIG']._serialized_end=311
-  _globals['_OPENCPNPTYCONFIG']._serialized_start=313
-  _globals['_OPENCPNPTYCONFIG']._serialized_end=391
-  _globals['_OPENCPNINTERFACECONFIG']._serialized_start=394
-  _globals['_OPENCPNINTERFACECONFIG']._serialized_end=814
+  _globals['_OPENCPNINTERFACECONFIG']._serialized_start=199
+  _globals['_OPENCPNINTERFACECONFIG']._serialized_end=603
 # @@protoc_insertion_point(module_scope)

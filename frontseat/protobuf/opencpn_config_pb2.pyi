@@ -3,85 +3,24 @@
 isort:skip_file
 goby-opencpn-interface's configuration (frontseat/apps/goby_opencpn_interface.py), shaped as Goby3's goby_opencpn_interface
 (src/zeromq/protobuf/opencpn_config.proto): same package, names and field numbers, so its config files parse
-unchanged.  TCPServerConfig and PTYConfig carry the fields of Goby's tcp_config.proto / pty_config.proto
-(text format does not name the type, so Goby's blocks parse as they are); bind_address is our extension.
+unchanged.  TCPServerConfig and PTYConfig are Goby's (gateway/goby/protobuf/io_config.proto).
 """
 
 from gateway.goby.protobuf import app_config_pb2 as _app_config_pb2
 from gateway.goby.protobuf import interprocess_config_pb2 as _interprocess_config_pb2
+from gateway.goby.protobuf import io_config_pb2 as _io_config_pb2
 from google.protobuf import descriptor as _descriptor
 from google.protobuf import message as _message
 import builtins as _builtins
 import sys
 import typing as _typing
 
-if sys.version_info >= (3, 11):
-    from typing import TypeAlias as _TypeAlias, Never as _Never
+if sys.version_info >= (3, 10):
+    from typing import TypeAlias as _TypeAlias
 else:
-    from typing_extensions import TypeAlias as _TypeAlias, Never as _Never
+    from typing_extensions import TypeAlias as _TypeAlias
 
 DESCRIPTOR: _descriptor.FileDescriptor
-
-@_typing.final
-class OpenCPNTCPServerConfig(_message.Message):
-    DESCRIPTOR: _descriptor.Descriptor
-
-    BIND_PORT_FIELD_NUMBER: _builtins.int
-    END_OF_LINE_FIELD_NUMBER: _builtins.int
-    SET_REUSEADDR_FIELD_NUMBER: _builtins.int
-    IPV6_FIELD_NUMBER: _builtins.int
-    BIND_ADDRESS_FIELD_NUMBER: _builtins.int
-    bind_port: _builtins.int
-    """the course uses 54000"""
-    end_of_line: _builtins.str
-    """accepted, unused: sentences always end with CR LF, as Goby writes them"""
-    set_reuseaddr: _builtins.bool
-    ipv6: _builtins.bool
-    bind_address: _builtins.str
-    """our extension: the address to bind (Goby binds every interface); loopback unless told otherwise"""
-    def __init__(
-        self,
-        *,
-        bind_port: _builtins.int | None = ...,
-        end_of_line: _builtins.str | None = ...,
-        set_reuseaddr: _builtins.bool | None = ...,
-        ipv6: _builtins.bool | None = ...,
-        bind_address: _builtins.str | None = ...,
-    ) -> None: ...
-    _HasFieldArgType: _TypeAlias = _typing.Literal["bind_address", b"bind_address", "bind_port", b"bind_port", "end_of_line", b"end_of_line", "ipv6", b"ipv6", "set_reuseaddr", b"set_reuseaddr"]  # noqa: Y015
-    def HasField(self, field_name: _HasFieldArgType) -> _builtins.bool: ...
-    _ClearFieldArgType: _TypeAlias = _typing.Literal["bind_address", b"bind_address", "bind_port", b"bind_port", "end_of_line", b"end_of_line", "ipv6", b"ipv6", "set_reuseaddr", b"set_reuseaddr"]  # noqa: Y015
-    def ClearField(self, field_name: _ClearFieldArgType) -> None: ...
-    def WhichOneof(self, oneof_group: _Never) -> None: ...
-
-Global___OpenCPNTCPServerConfig: _TypeAlias = OpenCPNTCPServerConfig  # noqa: Y015
-
-@_typing.final
-class OpenCPNPTYConfig(_message.Message):
-    DESCRIPTOR: _descriptor.Descriptor
-
-    PORT_FIELD_NUMBER: _builtins.int
-    BAUD_FIELD_NUMBER: _builtins.int
-    END_OF_LINE_FIELD_NUMBER: _builtins.int
-    port: _builtins.str
-    """the symlink created to the PTY's device, e.g. /tmp/ttyais0"""
-    baud: _builtins.int
-    end_of_line: _builtins.str
-    """accepted, unused (as above)"""
-    def __init__(
-        self,
-        *,
-        port: _builtins.str | None = ...,
-        baud: _builtins.int | None = ...,
-        end_of_line: _builtins.str | None = ...,
-    ) -> None: ...
-    _HasFieldArgType: _TypeAlias = _typing.Literal["baud", b"baud", "end_of_line", b"end_of_line", "port", b"port"]  # noqa: Y015
-    def HasField(self, field_name: _HasFieldArgType) -> _builtins.bool: ...
-    _ClearFieldArgType: _TypeAlias = _typing.Literal["baud", b"baud", "end_of_line", b"end_of_line", "port", b"port"]  # noqa: Y015
-    def ClearField(self, field_name: _ClearFieldArgType) -> None: ...
-    def WhichOneof(self, oneof_group: _Never) -> None: ...
-
-Global___OpenCPNPTYConfig: _TypeAlias = OpenCPNPTYConfig  # noqa: Y015
 
 @_typing.final
 class OpenCPNInterfaceConfig(_message.Message):
@@ -110,16 +49,16 @@ class OpenCPNInterfaceConfig(_message.Message):
         """also read from GOBY_INTERPROCESS"""
 
     @_builtins.property
-    def ais_server(self) -> Global___OpenCPNTCPServerConfig: ...
+    def ais_server(self) -> _io_config_pb2.TCPServerConfig: ...
     @_builtins.property
-    def ais_serial(self) -> Global___OpenCPNPTYConfig: ...
+    def ais_serial(self) -> _io_config_pb2.PTYConfig: ...
     def __init__(
         self,
         *,
         app: _app_config_pb2.AppConfig | None = ...,
         interprocess: _interprocess_config_pb2.InterProcessPortalConfig | None = ...,
-        ais_server: Global___OpenCPNTCPServerConfig | None = ...,
-        ais_serial: Global___OpenCPNPTYConfig | None = ...,
+        ais_server: _io_config_pb2.TCPServerConfig | None = ...,
+        ais_serial: _io_config_pb2.PTYConfig | None = ...,
         mmsi_start: _builtins.int | None = ...,
         filter_length: _builtins.int | None = ...,
         position_report_interval: _builtins.float | None = ...,
