@@ -24,7 +24,6 @@ import sys
 import termios
 import tty
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 from frontseat.groups import node_status
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
@@ -33,7 +32,7 @@ from gateway.goby.ais import AISConverter, AISError, AISFleet
 from gateway.goby.portal import SingleThreadApplication, StartError, run_application
 from gateway.goby.protobuf.io_config_pb2 import PTYConfig, TCPServerConfig
 from util.reactor import Reactor
-from util.sockets import accept_client
+from util.tcp_fanout import FanOutClient, FanOutServer
 
 log = logging.getLogger(__name__)
 
@@ -41,98 +40,41 @@ MAX_BACKLOG = 256 * 1024  # bytes queued for a client that is not reading before
 RECV_SIZE = 4096
 
 
-@dataclass
-class _Client:
-    sock: socket.socket
-    peer: str
-    outbuf: bytearray = field(default_factory=bytearray)
-
-
 class SentenceServer:
     """A TCP server on ``reactor`` that writes the same bytes to every connected client (Goby's ``all_clients``)."""
 
     def __init__(self, reactor: Reactor, cfg: TCPServerConfig) -> None:
-        self._reactor = reactor
-        self._clients: dict[socket.socket, _Client] = {}
         family = socket.AF_INET6 if cfg.ipv6 else socket.AF_INET
         address = cfg.bind_address
         if cfg.ipv6 and address == "127.0.0.1":
             address = "::1"
         if not 0 <= cfg.bind_port <= 65535:
             raise StartError(f"ais_server.bind_port {cfg.bind_port} out of range (0 to 65535)")
-        self._listener = socket.socket(family, socket.SOCK_STREAM)
+        listener = socket.socket(family, socket.SOCK_STREAM)
         try:
             if cfg.set_reuseaddr:
-                self._listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            self._listener.bind((address, cfg.bind_port))
-            self._listener.listen()
+                listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            listener.bind((address, cfg.bind_port))
+            listener.listen()
         except OSError as exc:
-            self._listener.close()
+            listener.close()
             raise StartError(f"cannot bind the AIS server to {address}:{cfg.bind_port}: {exc.strerror}") from None
-        self._listener.setblocking(False)
-        self.port: int = self._listener.getsockname()[1]
-        reactor.add_reader(self._listener, self._accept)
+        self.port: int = listener.getsockname()[1]
+        self._clients = FanOutServer(reactor, listener, max_backlog=MAX_BACKLOG, recv_size=RECV_SIZE,
+                                     on_data=_ignore_input)
+        self._clients.start()
         log.info("serving AIS on %s:%d", address, self.port)
 
     def write(self, payload: bytes) -> None:
-        for client in list(self._clients.values()):
-            client.outbuf += payload
-            if len(client.outbuf) > MAX_BACKLOG:
-                self._drop(client, f"not reading ({len(client.outbuf)} bytes queued)")
-                continue
-            self._flush(client)
+        self._clients.broadcast(payload)
 
     def close(self) -> None:
-        for client in list(self._clients.values()):
-            self._drop(client, "closed by server shutdown")
-        with contextlib.suppress(Exception):
-            self._reactor.remove_reader(self._listener)
-        self._listener.close()
+        self._clients.close()
 
-    def _accept(self) -> None:
-        accepted = accept_client(self._listener)
-        if accepted is None:
-            return
-        sock, peer = accepted
-        client = _Client(sock, peer)
-        self._clients[sock] = client
-        self._reactor.add_reader(sock, lambda: self._read(client))
-        log.info("client %s connected (%d connected)", peer, len(self._clients))
 
-    def _read(self, client: _Client) -> None:
-        try:
-            data = client.sock.recv(RECV_SIZE)
-        except (BlockingIOError, InterruptedError):
-            return
-        except OSError as exc:
-            self._drop(client, f"read failed: {exc}")
-            return
-        if not data:
-            self._drop(client, "disconnected")
-        else:
-            log.debug("ignoring %d bytes from %s", len(data), client.peer)
-
-    def _flush(self, client: _Client) -> None:
-        try:
-            sent = client.sock.send(client.outbuf)
-        except (BlockingIOError, InterruptedError):
-            sent = 0
-        except OSError as exc:
-            self._drop(client, f"write failed: {exc}")
-            return
-        del client.outbuf[:sent]
-        if client.outbuf:
-            self._reactor.add_writer(client.sock, lambda: self._flush(client))
-        else:
-            self._reactor.remove_writer(client.sock)
-
-    def _drop(self, client: _Client, why: str) -> None:
-        if self._clients.pop(client.sock, None) is None:
-            return
-        log.info("client %s %s (%d connected)", client.peer, why, len(self._clients))
-        self._reactor.remove_reader(client.sock)
-        self._reactor.remove_writer(client.sock)
-        client.sock.close()
+def _ignore_input(client: FanOutClient, data: bytes) -> None:
+    """OpenCPN may send routes and waypoints; Goby reads and drops them too."""
+    log.debug("ignoring %d bytes from %s", len(data), client.peer)
 
 
 class SentencePty:

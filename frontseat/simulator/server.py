@@ -13,26 +13,17 @@ from __future__ import annotations
 import logging
 import socket
 import threading
-from dataclasses import dataclass, field
 
 from frontseat.simulator.model import Simulation
 from frontseat.simulator.protocol import LineSplitter, encode_lines
 from util.reactor import Reactor, Timer
-from util.sockets import accept_client
+from util.tcp_fanout import FanOutClient, FanOutServer
 
 log = logging.getLogger(__name__)
 
 MAX_LINE = 64 * 1024  # bytes; longer lines are discarded (with an error logged)
 MAX_BACKLOG = 1024 * 1024  # bytes queued for a client that is not reading before we drop it
 RECV_SIZE = 65536
-
-
-@dataclass
-class _Client:
-    sock: socket.socket
-    peer: str
-    lines: LineSplitter = field(default_factory=lambda: LineSplitter(MAX_LINE))
-    outbuf: bytearray = field(default_factory=bytearray)
 
 
 class SimulatorServer:
@@ -46,10 +37,11 @@ class SimulatorServer:
     def __init__(self, host: str = "127.0.0.1", port: int = 0, simulation: Simulation | None = None) -> None:
         self.simulation = simulation if simulation is not None else Simulation()
         self._listener = socket.create_server((host, port), reuse_port=False)
-        self._listener.setblocking(False)
         self.host, self.port = self._listener.getsockname()[:2]
         self._reactor = Reactor("frontseat-sim")
-        self._clients: dict[socket.socket, _Client] = {}
+        self._clients = FanOutServer(self._reactor, self._listener, max_backlog=MAX_BACKLOG, recv_size=RECV_SIZE,
+                                     on_data=self._on_data, new_state=lambda: LineSplitter(MAX_LINE),
+                                     on_drop=self._on_drop)
         self._pending: list[str] = []
         self._tick_timer: Timer | None = None
         self._stopping = threading.Event()
@@ -72,7 +64,7 @@ class SimulatorServer:
         log.info("basic frontseat simulator listening on %s:%d", self.host, self.port)
         try:
             if not self._stopping.is_set():
-                self._reactor.add_reader(self._listener, self._accept)
+                self._clients.start()
                 self._reactor.run(until=self._stopping.is_set)
         except Exception:  # pragma: no cover - a bug; say so loudly rather than hang silently
             log.exception("simulator server loop failed")
@@ -106,37 +98,24 @@ class SimulatorServer:
 
     @property
     def client_count(self) -> int:
-        return len(self._clients)
+        return self._clients.client_count
 
     # ----- sockets (the serving thread) -------------------------------------------------------------------
-    def _accept(self) -> None:
-        accepted = accept_client(self._listener)
-        if accepted is None:
-            return
-        sock, peer = accepted
-        client = _Client(sock, peer)
-        self._clients[sock] = client
-        self._reactor.add_reader(sock, lambda: self._read(client))
-        log.info("client %s connected (%d connected)", client.peer, len(self._clients))
-
-    def _read(self, client: _Client) -> None:
-        try:
-            data = client.sock.recv(RECV_SIZE)
-        except (BlockingIOError, InterruptedError):
-            return
-        except OSError as exc:
-            self._drop(client, f"read failed: {exc}")
-            return
-        if not data:
-            self._drop(client, "disconnected")
-            return
-        lines = client.lines.feed(data)
-        if client.lines.overflowed:
+    def _on_data(self, client: FanOutClient, data: bytes) -> None:
+        splitter: LineSplitter = client.state
+        lines = splitter.feed(data)
+        if splitter.overflowed:
             log.error("client %s sent a line longer than %d bytes (lines must end with \\r\\n); "
                       "discarding it up to the next \\r\\n", client.peer, MAX_LINE)
         if lines:
             self._pending.extend(lines)
             self._keep_ticking()
+
+    @staticmethod
+    def _on_drop(client: FanOutClient) -> None:
+        splitter: LineSplitter = client.state
+        if splitter.partial:
+            log.info("client %s left a partial line of %d bytes; discarded", client.peer, splitter.partial)
 
     def _keep_ticking(self) -> None:
         """Arm the tick timer (aligned to the simulation's period, read at every tick: a START may change it)."""
@@ -150,47 +129,13 @@ class SimulatorServer:
             out.extend(self.simulation.handle_line(line))
         out.extend(self.simulation.tick())
         if out:
-            self._broadcast(encode_lines(out))
+            self._clients.broadcast(encode_lines(out))
         if not self.simulation.started and not self._pending and self._tick_timer is not None:
             self._tick_timer.cancel()  # nothing to simulate: sleep until a line arrives
-
-    def _broadcast(self, payload: bytes) -> None:
-        for client in list(self._clients.values()):
-            client.outbuf += payload
-            if len(client.outbuf) > MAX_BACKLOG:
-                self._drop(client, f"not reading ({len(client.outbuf)} bytes queued)")
-                continue
-            self._flush(client)
-
-    def _flush(self, client: _Client) -> None:
-        try:
-            sent = client.sock.send(client.outbuf)
-        except (BlockingIOError, InterruptedError):
-            sent = 0
-        except OSError as exc:
-            self._drop(client, f"write failed: {exc}")
-            return
-        del client.outbuf[:sent]
-        if client.outbuf:
-            self._reactor.add_writer(client.sock, lambda: self._flush(client))
-        else:
-            self._reactor.remove_writer(client.sock)
-
-    def _drop(self, client: _Client, why: str) -> None:
-        if self._clients.pop(client.sock, None) is None:
-            return
-        if client.lines.partial:
-            log.info("client %s left a partial line of %d bytes; discarded", client.peer, client.lines.partial)
-        log.info("client %s %s (%d connected)", client.peer, why, len(self._clients))
-        self._reactor.remove_reader(client.sock)
-        self._reactor.remove_writer(client.sock)
-        client.sock.close()
 
     def _close_all(self) -> None:
         if self._closed:
             return
         self._closed = True
-        for client in list(self._clients.values()):
-            self._drop(client, "closed by server shutdown")
+        self._clients.close()
         self._reactor.close()
-        self._listener.close()
