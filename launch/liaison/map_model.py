@@ -36,7 +36,7 @@ log = logging.getLogger(__name__)
 NODE_STATUS_TYPE = NodeStatus.DESCRIPTOR.full_name
 USV_COMMAND_TYPE = USVCommand.DESCRIPTOR.full_name
 HEALTH_STATUS_TYPE = HealthStatus.DESCRIPTOR.full_name
-HEALTH_RESEND_S = 1.0  # real seconds between updates of the health rows' ages when nothing new arrived
+HEALTH_RESEND_S = 1.0  # real seconds between updates of the ages (health rows, last reports) when nothing arrived
 Point = tuple[float, float]
 TRAIL_SPACING_M = 5.0  # a trail point is kept once the vehicle has moved this far from the last one
 MAX_VEHICLES = 256  # vehicles drawn; NodeStatus of further names is counted and dropped
@@ -66,6 +66,7 @@ class _Vehicle:
     heading: float = 0.0
     speed: float = 0.0
     time: float = 0.0
+    received: float = 0.0  # when its last NodeStatus arrived (this page's clock, sim s)
     appended: list[Point] = field(default_factory=list)
 
     def view(self, full: bool) -> dict[str, Any]:
@@ -144,22 +145,23 @@ class MapModel:
             command, self._command_payload = self._command_payload, None
             health, self._health_payload = self._health_payload, None
         health_changed = health is not None and self._update_health(*health)
-        health_due = bool(self._health) and time.monotonic() - self._health_sent >= HEALTH_RESEND_S
         changed = []
         for group, payload in nodes.items():
             vehicle = self._update_vehicle(group, payload)
             if vehicle is not None:
                 changed.append(vehicle)
+        ages_due = bool(self._health or self._vehicles) and time.monotonic() - self._health_sent >= HEALTH_RESEND_S
         if command is not None:
             self._apply_command(command)
         if not self._centred and self._usv() is not None:
             self._centre_polygon()
             self._centred = True
-        if not changed and not self._overlay_changed and not health_changed and not health_due:
+        if not changed and not self._overlay_changed and not health_changed and not ages_due:
             return None
         update: dict[str, Any] = {"vehicles": [v.view(full=False) for v in changed]}
-        if health_changed or health_due:
+        if health_changed or ages_due:
             update["health"] = self._health_view()
+            update["ages"] = self._report_ages()
         for vehicle in changed:
             vehicle.appended.clear()
         if self._overlay_changed:
@@ -170,7 +172,12 @@ class MapModel:
     def snapshot(self) -> dict[str, Any]:
         """Everything, trails included, for a page that just connected. Web thread."""
         return {"vehicles": [v.view(full=True) for v in self._vehicles.values()], **self._overlays(),
-                "health": self._health_view()}
+                "health": self._health_view(), "ages": self._report_ages()}
+
+    def _report_ages(self) -> dict[str, int]:
+        """Seconds (sim) since each vehicle's last NodeStatus arrived: how stale the topside's picture of it is."""
+        now = self._now()
+        return {name: max(0, round(now - vehicle.received)) for name, vehicle in self._vehicles.items()}
 
     def _health_view(self) -> list[dict[str, Any]]:
         self._health_sent = time.monotonic()
@@ -226,6 +233,7 @@ class MapModel:
         vehicle.heading = status.pose.heading % 360.0
         vehicle.speed = status.speed.over_ground
         vehicle.time = status.time
+        vehicle.received = self._now()
         point = (round(vehicle.x, 1), round(vehicle.y, 1))
         last = vehicle.trail[-1] if vehicle.trail else None
         if last is None or math.hypot(point[0] - last[0], point[1] - last[1]) >= TRAIL_SPACING_M:

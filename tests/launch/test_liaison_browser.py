@@ -193,5 +193,9 @@ def test_map_draws_the_vehicle_its_trail_and_the_overlays(mission, browser):
              > 3, what="a trail")
     assert len(browser.find_element("id", "map-waypoints").get_attribute("points").split()) > 50
     assert len(browser.find_element("id", "map-polygon").get_attribute("points").split()) in (6, 8)
+    # the vehicle's row says how long ago its last report arrived (a live vehicle: a few seconds at most)
+    age = wait_until(lambda: browser.find_element("css selector", "#vehicle-table tbody tr td:nth-child(6)").text,
+                     what="the last report's age")
+    assert 0 <= int(age) < 30
     time.sleep(2)  # let the trail grow for the picture
     screenshot(browser, "map")

@@ -19,6 +19,10 @@ const LiveMap = {
     if (msg.waypoints !== undefined) this.setOverlays(msg);
     for (const data of msg.vehicles || []) this.updateVehicle(data, msg.full);
     if (msg.health !== undefined) this.setHealth(msg.health);
+    for (const [name, age] of Object.entries(msg.ages || {})) {
+      const v = this.vehicles.get(name);
+      if (v) v.row.children[5].textContent = String(age);
+    }
   },
 
   // Each vehicle's last HealthStatus: state, its time of day (time2 carries only that), age since it arrived (sim s).
@@ -57,7 +61,7 @@ const LiveMap = {
            trail: svg("polyline", {class: "trail", "data-name": data.name}),
            row: el("tr", {"data-vehicle": data.name}), points: []};
       v.label.textContent = data.name;
-      for (let i = 0; i < 5; i++) v.row.append(el("td"));
+      for (let i = 0; i < 6; i++) v.row.append(el("td"));
       document.getElementById("map-trails").append(v.trail);
       document.getElementById("map-vehicles").append(v.icon, v.label);
       document.querySelector("#vehicle-table tbody").append(v.row);
