@@ -48,6 +48,7 @@ from behaviors.helm.testing import helm_from_text
 from behaviors.testing import ORIGIN, write_helm_mission
 from bench.netns import NETNS_FLAG, reexec_in_netns
 from bench.platform_proc import ProcSample, process_cpu_between, sample
+from bench.progress import progress
 from bench.stats import markdown_table
 from gateway.moos import MoosClock, comms
 from gateway.moos.testing import MoosDBProcess, private_netns
@@ -73,9 +74,6 @@ Behavior = BHV_Waypoint
 }
 """
 
-
-def progress(line: str) -> None:
-    print(line, file=sys.stderr, flush=True)
 
 
 # ---- core: one iteration, no MOOS -----------------------------------------------------------------------------
@@ -375,8 +373,7 @@ def main(argv: list[str] | None = None) -> int:
             parser.error(f"--python-root {root}: no behaviors/apps/ivp_helm.py there")
     phelmivp, why_not = (None, "--no-live") if args.no_live else find_phelmivp()
     if phelmivp is not None and not args.in_netns and not private_netns():
-        code = reexec_in_netns("bench.bench_helm", argv, "pHelmIvP", "pHelmIvP listens on all addresses",
-                               say=progress)
+        code = reexec_in_netns("bench.bench_helm", argv, "pHelmIvP", "pHelmIvP listens on all addresses")
         if code is not None:
             return code
         phelmivp, why_not = None, "no private network namespace"

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bench.netns import NETNS_FLAG, reexec_in_netns
+from bench.progress import progress
 from bench.stats import markdown_table
 from gateway.goby.log import FILE_DESCRIPTOR_GROUP, EntryDecoder, LogReader, LogWriter, debug_text_line
 from gateway.goby.portal import Scheme
@@ -60,9 +61,6 @@ TYPE = Sample.DESCRIPTOR.full_name
 TRAIL_PLATFORMS = ("topside", "usv", "auv0", "auv1", "auv2", "auv3")
 TRAIL_WARP = 10
 
-
-def progress(line: str) -> None:
-    print(line, file=sys.stderr, flush=True)
 
 
 # ---- 1. the logger under one publisher --------------------------------------------------------------------------
@@ -466,8 +464,7 @@ def main(argv: list[str] | None = None) -> int:
         elif args.in_netns or private_netns():
             programs = found
         else:
-            status = reexec_in_netns("bench.bench_logger", argv, "C++ logger", "the real gobyd listens on all addresses",
-                                     say=progress)
+            status = reexec_in_netns("bench.bench_logger", argv, "C++ logger", "the real gobyd listens on all addresses")
             if status is not None:
                 return status
     sides = ["python", *(["cpp"] if programs else [])]

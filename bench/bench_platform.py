@@ -53,6 +53,7 @@ from bench.platform_vehicle import (
     run_directory,
     vehicle_settings,
 )
+from bench.progress import progress
 from bench.stats import markdown_table
 from gateway.moos.testing import private_netns
 from launch.errors import LaunchError
@@ -65,10 +66,6 @@ log = logging.getLogger(__name__)
 HERE = Path(__file__).resolve().parent.parent
 MIB = 2**20
 
-
-def progress(line: str) -> None:
-    """A progress line on stderr (the tables go to stdout)."""
-    print(line, file=sys.stderr, flush=True)
 
 
 # ---- one run ----------------------------------------------------------------------------------------------------
@@ -263,7 +260,7 @@ def main(argv: list[str] | None = None) -> int:
             programs = found
         else:
             status = reexec_in_netns("bench.bench_platform", argv, "C++ vehicle",
-                                     "the real MOOSDB listens on all addresses", say=progress)
+                                     "the real MOOSDB listens on all addresses")
             if status is not None:
                 return status
     print(f"one USV vehicle, Python{' vs C++' if programs else ''}: {args.seconds:g} s measured per run after "

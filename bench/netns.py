@@ -15,17 +15,15 @@ import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
+from bench.progress import progress
+
 NETNS_FLAG = "--in-netns"
 REPO = Path(__file__).resolve().parents[1]
 SCRIPT = 'ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo && exec "$@"'
 
 
-def _say(line: str) -> None:
-    print(line, file=sys.stderr, flush=True)
-
-
 def reexec_in_netns(module: str, argv: list[str], skipped: str, why_needed: str,
-                    env: Mapping[str, str] | None = None, say: Callable[[str], None] = _say) -> int | None:
+                    env: Mapping[str, str] | None = None, say: Callable[[str], None] = progress) -> int | None:
     """Run ``python -m module *argv --in-netns`` inside a new private network namespace and return its exit status;
     None when no namespace can be made (then ``"(<skipped> skipped: <reason>)"`` is said and the caller runs ours
     alone). ``why_needed`` ends the line said before the re-run; ``env`` replaces the environment (this checkout is
