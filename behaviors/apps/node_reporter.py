@@ -1,15 +1,14 @@
 """``node-reporter``: pNodeReporter's role as a MOOS app, reading its ``ProcessConfig = pNodeReporter`` block.
 
 It posts ``NODE_REPORT_LOCAL`` (``node_report_output``) in pNodeReporter's format every ``AppTick`` (scaled by
-MOOSTimeWarp), once ownship's NAV_* make a valid record. Threads: the MOOS client's I/O thread runs the
-on-connect callback (registrations); the thread that calls :meth:`NodeReporterApp.run` fetches mail and posts.
+MOOSTimeWarp), once ownship's NAV_* make a valid record. Threads: one. The reporter and its MOOS client live on one
+:class:`util.reactor.Reactor` (``comms(reactor=...)``), as ivp-helm: the AppTick is a reactor timer that handles the
+mail received since the last tick, then iterates; arriving mail only lands in the client's inbox.
 """
 
 from __future__ import annotations
 
 import logging
-import threading
-import time
 from pathlib import Path
 
 from behaviors.node_reporter import REGISTRATIONS, NodeReporter, NodeReporterConfig
@@ -17,13 +16,14 @@ from gateway.apps.moos_tool_args import parse_moos_app_args
 from gateway.moos import MissionFileError, MoosClock, comms
 from gateway.moos.mission_file import MissionFile
 from util.process import handle_signals
+from util.reactor import Reactor, Timer
 
 log = logging.getLogger(__name__)
 DEFAULT_APP_NAME = "pNodeReporter"
 
 
 class NodeReporterApp:
-    """One reporter connected to the mission's MOOSDB."""
+    """One reporter connected to the mission's MOOSDB, served by :meth:`run` on the calling thread."""
 
     def __init__(self, mission_path: str | Path, alias: str | None = None) -> None:
         self.mission = MissionFile(mission_path)
@@ -35,38 +35,41 @@ class NodeReporterApp:
             log.warning("%s", problem)
         self.clock = MoosClock(self.mission.time_warp)
         self.reporter = NodeReporter(self.mission.community, self.config)
-        self.comms = comms(clock=self.clock)
-        self._wake = threading.Event()
+        self.reactor = Reactor(f"node-reporter-{self.name}")
+        self.comms = comms(clock=self.clock, reactor=self.reactor)
+        self._tick: Timer | None = None
+        self._stop_requested = False
 
-    def run(self, stop: threading.Event) -> None:
-        """Serve until ``stop`` is set; runs on the calling thread."""
-        self.comms.set_on_connect_callback(lambda: all(self.comms.register(v, 0) for v in REGISTRATIONS))
-        self.comms.set_on_mail_callback(self._on_mail)
-        self.comms.run(self.mission.server_host, self.mission.server_port, self.name)
-        period = 1.0 / (self.config.app_tick * self.clock.warp)
-        next_tick = time.monotonic()
+    def run(self) -> None:
+        """Connect and serve on the calling thread until :meth:`stop`."""
         try:
-            while not stop.is_set():
-                self._wake.wait(max(0.0, next_tick - time.monotonic()))
-                self._wake.clear()
-                now = self.clock.time()
-                for msg in self.comms.fetch():
-                    if not msg.is_binary():
-                        self.reporter.handle_mail(msg.key(), msg.double() if msg.is_double() else msg.string(), now)
-                if time.monotonic() >= next_tick:
-                    for var, report in self.reporter.iterate(now):
-                        self.comms.notify(var, report)
-                    next_tick = max(next_tick + period, time.monotonic())
+            self.comms.set_on_connect_callback(self._on_connect)
+            self.comms.run(self.mission.server_host, self.mission.server_port, self.name)
+            self.reactor.run(until=lambda: self._stop_requested)
         finally:
             self.comms.close(True)
+            self.reactor.close()
 
-    def wake(self) -> None:
-        self._wake.set()
+    def stop(self) -> None:
+        """Make :meth:`run` return (from any thread, a signal handler included)."""
+        self._stop_requested = True
+        self.reactor.stop()
 
-    def _on_mail(self) -> bool:
-        """Runs on the MOOS client's I/O thread: only wakes the loop."""
-        self._wake.set()
-        return True
+    def _on_connect(self) -> bool:
+        """Every (re)connection registers; the first one starts the AppTick."""
+        ok = all(self.comms.register(v, 0) for v in REGISTRATIONS)
+        if self._tick is None:
+            self._tick = self.reactor.call_every(lambda: 1.0 / (self.config.app_tick * self.clock.warp), self._on_tick)
+        return ok
+
+    def _on_tick(self) -> None:
+        """pNodeReporter's DoRunWork: the mail since the last tick, then Iterate."""
+        now = self.clock.time()
+        for msg in self.comms.fetch():
+            if not msg.is_binary():
+                self.reporter.handle_mail(msg.key(), msg.double() if msg.is_double() else msg.string(), now)
+        for var, report in self.reporter.iterate(now):
+            self.comms.notify(var, report)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -77,10 +80,10 @@ def main(argv: list[str] | None = None) -> int:
     except MissionFileError as exc:
         log.error("%s", exc)
         return 2
-    with handle_signals(lambda _signum: app.wake()) as stop:
+    with handle_signals(lambda _signum: app.stop()):
         log.info("%s reporting %s on %s:%d", app.name, app.mission.community, app.mission.server_host,
                  app.mission.server_port)
-        app.run(stop)
+        app.run()
     return 0
 
 

@@ -173,9 +173,13 @@ class MoosDB:
         self.stop()
 
     def serve_forever(self) -> None:
-        """Block until :meth:`stop` is called from elsewhere (a signal handler, another thread)."""
-        while self._thread is not None and self._thread.is_alive():
-            self._thread.join(0.5)
+        """Block until :meth:`stop` is called from elsewhere (a signal handler, another thread).
+
+        A plain join, not a polling one: a signal still runs its handler during it (lock waits are interruptible
+        on POSIX), and nothing wakes on a period."""
+        thread = self._thread
+        if thread is not None:
+            thread.join()
 
     @property
     def address(self) -> tuple[str, int]:

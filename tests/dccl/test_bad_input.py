@@ -108,7 +108,7 @@ def test_text_that_is_not_utf8_is_refused(codec):
 LOADED_IDS = [3, 20, 124, 125, 126, 127]
 
 
-@settings(max_examples=500, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=500, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(head=st.sampled_from([bytes([i << 1]) for i in LOADED_IDS] + [b"\xb1\x04", b""]), tail=st.binary(max_size=64))
 def test_random_bytes_decode_or_raise_the_codecs_own_error(codec, head, tail):
     data = head + tail

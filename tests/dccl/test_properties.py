@@ -213,7 +213,7 @@ def fill(msg: Any, specs: tuple[Spec, ...] | list[Spec], values: dict[str, Any])
             setattr(msg, spec.field.name, value)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=300)
 @given(data=st.data())
 def test_random_definitions_round_trip_with_the_spec_sizes(data):
     specs = data.draw(definitions())
@@ -271,7 +271,7 @@ STEPS = {"x": 0.1, "y": 0.1, "speed_over_ground": 0.1, "z": 1, "heading": 1, "po
 
 
 @pytest.mark.parametrize("message_type", COURSE_TYPES, ids=lambda t: t.DESCRIPTOR.name)
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=300)
 @given(data=st.data())
 def test_course_messages_round_trip_up_to_their_documented_quantisation(message_type, data):
     values = {}
