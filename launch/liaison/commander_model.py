@@ -8,6 +8,7 @@ scheduling :meth:`CommanderModel.published`, :meth:`acknowledged` and :meth:`exp
 from __future__ import annotations
 
 import itertools
+import re
 import time
 from collections import deque
 from dataclasses import dataclass, field
@@ -24,6 +25,26 @@ from util.descriptors import descriptor_of
 
 #: Sent, then one of the final states.
 SENDING, SENT, ACKNOWLEDGED, REFUSED, EXPIRED, FAILED = "sending", "sent", "acknowledged", "refused", "expired", "failed"
+
+# AckData / ExpireData's ``latency`` (int64, microseconds by its DCCL units) in their text form; not ``link_latency``.
+LINK_REPORTS = ("Ack: ", "Expire: ")  # how portal_side prefixes the link's AckData / ExpireData texts
+_LATENCY_US = re.compile(r"(?<![\w.])latency: (-?\d+)(?![\w.])")
+
+
+def latency_text(microseconds: int) -> str:
+    """A link latency with its unit: ``850.2 ms`` below a second, ``2.378 s`` from there."""
+    if abs(microseconds) < 1_000_000:
+        return f"{microseconds / 1e3:.1f} ms"
+    return f"{microseconds / 1e6:.3f} s"
+
+
+def with_latency_unit(text: str) -> str:
+    """A link's ack or expiry text (``Ack: header {...} latency: 2378143``, ``Expire: ...``) with the latency in ms
+    or s, as ``latency: 2.378 s``: the field is microseconds (its DCCL units), which a bare number does not say.
+    Other texts (an interprocess ack message, whose fields mean what their type says) are returned as they are."""
+    if not text.startswith(LINK_REPORTS):
+        return text
+    return _LATENCY_US.sub(lambda m: f"latency: {latency_text(int(m.group(1)))}", text)
 
 
 def layer_text(layer: Layer.ValueType) -> str:
@@ -136,7 +157,7 @@ class CommanderModel:
         entry = self.find(entry_id)
         if entry is None:
             return None
-        entry.acks.append(text)
+        entry.acks.append(with_latency_unit(text))
         if refused:
             entry.state = REFUSED
         elif final and entry.state in (SENDING, SENT, EXPIRED):
@@ -157,7 +178,7 @@ class CommanderModel:
         entry = self.find(entry_id)
         if entry is not None and entry.state in (SENDING, SENT):
             entry.state = EXPIRED
-            entry.acks.append(text)
+            entry.acks.append(with_latency_unit(text))
         return entry
 
     def expire_due(self, now: float) -> list[SentCommand]:

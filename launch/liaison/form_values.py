@@ -16,6 +16,7 @@ from typing import Any
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
+from gateway.goby.dccl.arith import quantize_float, quantize_int
 from launch.liaison.errors import CommandRefused
 from launch.liaison.form_schema import (
     FLOAT_MAX,
@@ -114,7 +115,8 @@ def _check_limits(field: FieldDescriptor, value: Any, path: str) -> None:
     bounds = dccl_bounds(field)
     if bounds is not None and isinstance(value, int | float) and not isinstance(value, bool):
         low, high, step = bounds
-        rounded = math.floor(value / step + 0.5) * step  # DCCL rounds to the step, then checks
+        # DCCL rounds (as its codec: integers by remainder toward zero), then checks
+        rounded = quantize_int(value, step) if isinstance(value, int) else quantize_float(value, step)
         if not low <= rounded <= high:
             raise CommandRefused(f"{path}: {value:g} is outside its DCCL bounds {describe_bounds(low, high, step)}",
                                  path)

@@ -3,17 +3,45 @@
 
 const INT_KINDS = ["int", "uint", "int64", "uint64"];
 const NUMBER_KINDS = INT_KINDS.concat(["float", "double"]);
+const SENT_COLUMNS = 8;  // #, time, type, sent to, message, state, acknowledgements, comment
+
+// The value DCCL carries for `number` in a field of step `step` (its precision), as its codec quantizes it
+// (gateway/goby/dccl/arith.py): integers take the remainder toward zero, then go up a step from half a step;
+// reals go to the nearest multiple, halves up.
+function dcclQuantize(number, step, integer) {
+  if (integer) {
+    if (!(step > 1) || !Number.isInteger(step)) return number;
+    const rem = number % step;  // toward zero, as C++
+    return number - rem + (rem >= step / 2 ? step : 0);
+  }
+  if (step >= 1) return Math.floor(number / step + 0.5) * step;
+  const inverse = 1 / step;
+  return Math.floor(number * inverse + 0.5) / inverse;
+}
+
+// A number as DCCL's step shows it (no binary fraction noise: 0.30000000000000004 -> 0.3).
+function stepText(number, step) {
+  const places = step < 1 ? Math.min(12, Math.ceil(-Math.log10(step) - 1e-9)) : 0;
+  return String(Number(number.toFixed(places)));
+}
 
 const Commander = {
   types: [],
   current: null,
   sent: new Map(),  // id -> <tr>
+  roundings: [],    // the values of the form being sent that DCCL's precision changes
+  notes: new Map(), // sent id -> those changes, said in its log row (this page's commands)
 
   init() {
+    const head = document.querySelector("#sent-table thead tr");
+    if (head && head.children.length < SENT_COLUMNS) head.append(el("th", {text: "Comment"}));
     Liaison.on("commands", (msg) => this.setTypes(msg.types));
     Liaison.on("sent", (msg) => this.showSent(msg.entries, msg.full));
     Liaison.on("accepted", (msg) => {
-      this.status(`sent #${msg.id} to ${msg.target}`);
+      const changed = this.roundings.splice(0);
+      if (changed.length) this.notes.set(msg.id, changed);
+      while (this.notes.size > 200) this.notes.delete(this.notes.keys().next().value);  // the server keeps 200
+      this.status(`sent #${msg.id} to ${msg.target}` + (changed.length ? `; ${changed.join("; ")}` : ""));
       this.clearErrors();
     });
     Liaison.on("refused", (msg) => this.showError(msg.error, msg.field, "refused by the server: "));
@@ -88,9 +116,35 @@ const Commander = {
     }
     const input = this.input(field, path);
     const hint = this.hint(field);
+    const rounding = el("strong", {class: "rounding", "data-rounding": path, role: "status"});
+    if (this.roundingOf(field)) {
+      input.addEventListener("input", () => {
+        const note = this.roundingNote(input);
+        rounding.textContent = note ? ` — ${note}` : "";
+      });
+    }
     return el("div", {class: "field"},
       el("label", {htmlFor: `f-${path}`}, path, field.label === "required" ? el("span", {class: "req", text: " *"}) : null),
-      input, el("span", {class: "hint", text: hint}));
+      input, el("span", {class: "hint"}, hint, rounding));
+  },
+
+  // The step DCCL rounds this field's values to, or null when it carries every value as typed.
+  roundingOf(field) {
+    if (!field.dccl_bounds || !field.step || field.auto_time) return null;
+    if (INT_KINDS.includes(field.kind) && field.step <= 1) return null;
+    return field.step;
+  },
+
+  // "polygon_radius: 405 is sent as 410 (DCCL precision: steps of 10)", or null if the typed value goes as it is.
+  roundingNote(input) {
+    const field = input._field;
+    const step = this.roundingOf(field);
+    const number = Number(input.value.trim());
+    if (step === null || input.value.trim() === "" || !isFinite(number)) return null;
+    const sent = dcclQuantize(number, step, INT_KINDS.includes(field.kind));
+    if (Math.abs(sent - number) <= Math.abs(number) * 1e-12) return null;
+    return `${input.dataset.path}: ${input.value.trim()} is sent as ${stepText(sent, step)} ` +
+      `(DCCL precision: steps of ${stepText(step, step)})`;
   },
 
   input(field, path) {
@@ -127,7 +181,10 @@ const Commander = {
   hint(field) {
     const parts = [field.kind];
     if (field.auto_time) parts.push("DCCL time: filled when sent");
-    if (field.dccl_bounds) parts.push(`DCCL [${field.min}, ${field.max}]` + (field.step !== 1 ? ` step ${field.step}` : ""));
+    if (field.dccl_bounds) {
+      parts.push(`DCCL [${field.min}, ${field.max}]` + (field.step !== 1 ? ` step ${field.step}` : ""));
+      if (this.roundingOf(field)) parts.push(`values are rounded to a multiple of ${field.step}`);
+    }
     if (field.max_length) parts.push(`at most ${field.max_length} characters`);
     if (field.oneof) parts.push(`oneof ${field.oneof}`);
     if (field.description) parts.push(field.description);
@@ -162,11 +219,13 @@ const Commander = {
     if (INT_KINDS.includes(field.kind) && !Number.isInteger(number)) fail(`${raw} is not a whole number`);
     if (field.min !== undefined && field.max !== undefined) {
       const step = field.dccl_bounds && field.step ? field.step : null;
-      const rounded = step ? Math.floor(number / step + 0.5) * step : number;  // DCCL rounds, then checks
-      if (rounded < field.min || rounded > field.max) {
+      const sent = step ? dcclQuantize(number, step, INT_KINDS.includes(field.kind)) : number;  // DCCL rounds, then checks
+      if (sent < field.min || sent > field.max) {
         const range = `[${field.min}, ${field.max}]` + (step && step !== 1 ? `, in steps of ${step}` : "");
         fail(`${raw} is outside its ${field.dccl_bounds ? "DCCL bounds" : "range"} ${range}`);
       }
+      const note = this.roundingNote(input);
+      if (note) this.roundings.push(note);
     }
     return number;
   },
@@ -206,6 +265,7 @@ const Commander = {
   submit() {
     this.clearErrors();
     if (!this.current) return;
+    this.roundings = [];
     let values;
     try {
       values = this.collect(document.getElementById("command-fields"), this.current.schema, "");
@@ -243,7 +303,7 @@ const Commander = {
       let tr = this.sent.get(entry.id);
       if (!tr) {
         tr = el("tr", {"data-sent-id": String(entry.id)});
-        for (let i = 0; i < 7; i++) tr.append(el("td"));
+        for (let i = 0; i < SENT_COLUMNS; i++) tr.append(el("td"));
         body.prepend(tr);
         this.sent.set(entry.id, tr);
       }
@@ -252,10 +312,13 @@ const Commander = {
       cells[1].textContent = timeText(entry.time);
       cells[2].textContent = entry.type;
       cells[3].textContent = entry.target;
-      cells[4].textContent = entry.text;
+      const notes = this.notes.get(entry.id);
+      cells[4].textContent = entry.text + (notes ? `\n(${notes.join("; ")})` : "");
       cells[5].textContent = entry.state + (entry.error ? `: ${entry.error}` : "");
       cells[5].className = `state state-${entry.state}`;
       cells[6].textContent = entry.acks.join("\n");
+      cells[7].textContent = entry.comment;
+      cells[7].className = "comment";
     }
   },
 

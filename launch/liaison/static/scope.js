@@ -1,14 +1,35 @@
 // Scope: one row per (group, type, scheme), updated from the server's coalesced updates.
 "use strict";
 
+// Goby's liaison matches a filter against the whole name (regex_match), and so does this page; the page says so.
+const WHOLE_NAME_HINT = "Expressions match the whole name, as in Goby's liaison: \"state\" finds only a name that " +
+  "is exactly \"state\"; \".*state.*\" finds every name containing it.";
+const MATCH_ALL = ["", ".*"];
+
+// The expression that finds names containing what `expression` matches: `state` -> `.*state.*`.
+function containing(expression) {
+  if (expression.startsWith(".*") && expression.endsWith(".*")) return expression;
+  return expression.includes("|") ? `.*(?:${expression}).*` : `.*${expression}.*`;
+}
+
 const Scope = {
   rows: new Map(),      // id -> {tr, cells, data, key}
+  filters: {group: ".*", type: ".*"},  // what the server applies (its last "hello" or "filter" reply)
+  synced: false,        // a full update for the current filters has arrived
   histories: new Map(), // id -> history <tr>
   paused: false,
   received: 0,
 
   init() {
     const form = document.getElementById("scope-filters");
+    for (const what of ["group", "type"]) {
+      const input = document.getElementById(`${what}-filter`);
+      input.placeholder = "whole name, e.g. .*state.*";
+      input.title = `Regular expression (RE2) for the ${what} name. ${WHOLE_NAME_HINT}`;
+    }
+    const hint = el("div", {id: "filter-hint", class: "status", text: WHOLE_NAME_HINT});
+    const empty = el("div", {id: "filter-empty", class: "status", role: "status", hidden: true});
+    document.getElementById("filter-error").after(hint, empty);
     form.addEventListener("submit", (e) => { e.preventDefault(); this.setFilter(); });
     document.getElementById("filter-clear").addEventListener("click", () => {
       document.getElementById("group-filter").value = ".*";
@@ -19,10 +40,14 @@ const Scope = {
     Liaison.on("hello", (msg) => {
       document.getElementById("group-filter").value = msg.filters.group;
       document.getElementById("type-filter").value = msg.filters.type;
+      this.applied(msg.filters.group, msg.filters.type);
       this.showPaused(msg.start_paused);
     });
     Liaison.on("scope", (msg) => this.update(msg));
-    Liaison.on("filter", () => { document.getElementById("filter-error").textContent = ""; });
+    Liaison.on("filter", (msg) => {
+      document.getElementById("filter-error").textContent = "";
+      this.applied(msg.group, msg.type);
+    });
     Liaison.on("paused", (msg) => this.showPaused(msg.paused));
     Liaison.on("history", (msg) => this.showHistory(msg.id, msg.items));
     Liaison.on("error", (msg) => {
@@ -41,6 +66,12 @@ const Scope = {
       }
     }
     Liaison.send({op: "filter", group: group, type: type});
+  },
+
+  applied(group, type) {
+    this.filters = {group, type};
+    this.synced = false;  // until the full update for these filters
+    this.status();
   },
 
   setPaused(paused) {
@@ -65,6 +96,7 @@ const Scope = {
       for (const id of [...this.rows.keys()]) if (!keep.has(id)) this.remove(id);
     }
     for (const row of msg.rows) this.upsert(row);
+    if (msg.full) this.synced = true;
     this.received += msg.rows.length;
     this.status();
   },
@@ -141,5 +173,24 @@ const Scope = {
     const shown = this.rows.size;
     document.getElementById("scope-status").textContent =
       `${shown} row(s)${this.paused ? " — paused" : ""}`;
+    this.showEmpty(shown === 0 && this.synced);
+  },
+
+  // When the filters leave no row: say why that may be (whole-name matching) and offer the `.*x.*` form.
+  showEmpty(empty) {
+    const line = document.getElementById("filter-empty");
+    const narrowing = ["group", "type"].filter((what) => !MATCH_ALL.includes(this.filters[what]));
+    if (!line || !empty || !narrowing.length) { if (line) line.hidden = true; return; }
+    const parts = narrowing.map((what) => `${what} ${JSON.stringify(this.filters[what])}`);
+    const suggestion = narrowing.map((what) => JSON.stringify(containing(this.filters[what]))).join(" / ");
+    const button = el("button", {type: "button", id: "filter-containing", text: `Use ${suggestion}`});
+    button.addEventListener("click", () => {
+      for (const what of narrowing) document.getElementById(`${what}-filter`).value = containing(this.filters[what]);
+      this.setFilter();
+    });
+    line.replaceChildren(`No name matches ${parts.join(" and ")} as a whole (names are matched whole, as in ` +
+      `Goby's liaison), or nothing matching has been published yet. To find names containing it, try ` +
+      `${suggestion}. `, button);
+    line.hidden = false;
   },
 };
