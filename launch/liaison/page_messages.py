@@ -82,6 +82,18 @@ def int_field(request: dict[str, Any], name: str, low: int = 0, high: int = MAX_
     return value
 
 
+def float_field(request: dict[str, Any], name: str, low: float, high: float) -> float:
+    """A required finite number in ``[low, high]`` (an integer is accepted, a bool is not)."""
+    if name not in request:
+        raise PageMessageError(f'"{name}" is missing')
+    value = request[name]
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        raise PageMessageError(f'"{name}" must be a number, not {_shown(value)}')
+    if not (math.isfinite(value) and low <= value <= high):
+        raise PageMessageError(f'"{name}" {_shown(value)} is outside [{low:g}, {high:g}]')
+    return float(value)
+
+
 def str_field(request: dict[str, Any], name: str, default: str, max_chars: int = MAX_NAME_CHARS) -> str:
     """An optional string field of at most ``max_chars`` characters."""
     value = request.get(name, default)

@@ -20,15 +20,23 @@ from gateway.goby.portal.errors import ClosedError
 from gateway.goby.portal.group import Group
 from gateway.goby.portal.marshalling import Scheme
 from gateway.goby.protobuf.layer_pb2 import LAYER_INTERTHREAD, LAYER_INTERVEHICLE
+from gateway.moos.client import comms
 from launch.liaison.commander_model import CommanderModel, CommandType, Target
 from launch.liaison.errors import LiaisonError
-from launch.liaison.map_model import HEALTH_STATUS_TYPE, NODE_STATUS_TYPE, USV_COMMAND_TYPE, MapModel
+from launch.liaison.map_model import (
+    HEALTH_STATUS_TYPE,
+    HELM_VARIABLES,
+    NAV_REPORT_TYPE,
+    NODE_STATUS_TYPE,
+    USV_COMMAND_TYPE,
+    MapModel,
+)
 from launch.liaison.message_types import find_message_type
 from launch.liaison.protobuf.liaison_config_pb2 import LiaisonConfig
 from launch.liaison.protobuf.liaison_web_pb2 import InterProcessAck
 from launch.liaison.scope_model import ScopeModel
 from launch.liaison.server import WebServer
-from launch.liaison.settings import LiaisonSettings, load_settings
+from launch.liaison.settings import LiaisonSettings, MoosEndpoint, load_settings
 
 log = logging.getLogger(__name__)
 
@@ -47,7 +55,10 @@ class LiaisonApp(SingleThreadApplication):
         self.settings = s
         self.scope = ScopeModel(s.max_history, s.max_rows, s.max_message_size)
         clock = self.context.clock
-        self.map = MapModel(s.waypoints, s.polygon, s.center_activate, s.trail_points, clock.now)
+        self.map = MapModel(s.waypoints, s.polygon, s.center_activate, s.trail_points, clock.now,
+                            initial_mode=s.initial_mode, datum=s.datum, helm_views=s.moos is not None,
+                            background=s.background)
+        self._moos: Any = None
         self.commander = CommanderModel(s.command_types, s.command_history)
         self.web = WebServer(s, self.scope, self.commander, self.map, self._hand_over, clock.now)
         portal = self.interprocess()
@@ -55,6 +66,8 @@ class LiaisonApp(SingleThreadApplication):
         for kind in s.command_types:
             if kind.ack is not None:
                 self._subscribe_ack(kind.ack)
+        if s.moos is not None:
+            self._read_helm(s.moos)
         try:
             self.web.start()
         except LiaisonError as exc:
@@ -75,6 +88,31 @@ class LiaisonApp(SingleThreadApplication):
                 self.map.ingest_command(payload)
             elif type_name == HEALTH_STATUS_TYPE:
                 self.map.ingest_health(payload)
+            elif type_name == NAV_REPORT_TYPE:
+                self.map.ingest_nav_report(group, payload)
+
+    def _read_helm(self, endpoint: MoosEndpoint) -> None:
+        """Read the helm's VIEW_* and DEPLOY_STATE from the vehicle's MOOSDB, as pMarineViewer does: a MOOS client
+        on this thread's reactor (no thread of its own); it reconnects by itself if the MOOSDB is not up yet."""
+        client = comms(reactor=self.reactor)
+
+        def on_connect() -> bool:
+            for variable in HELM_VARIABLES:
+                client.register(variable, 0)
+            return True
+
+        def on_mail() -> bool:
+            for msg in client.fetch():
+                if msg.is_string():
+                    self.map.ingest_moos(msg.key(), msg.string())
+            return True
+
+        client.set_on_connect_callback(on_connect)
+        client.set_on_mail_callback(on_mail)
+        client.run(endpoint.host, endpoint.port, endpoint.name)
+        self._moos = client
+        log.info("reading the helm's %s from the MOOSDB at %s:%d", ", ".join(HELM_VARIABLES), endpoint.host,
+                 endpoint.port)
 
     def _subscribe_ack(self, rule: InterProcessAck) -> None:
         ack_cls = find_message_type(rule.ack_type)
@@ -139,6 +177,9 @@ class LiaisonApp(SingleThreadApplication):
         self.web.stop()
 
     def close(self) -> None:
+        if self._moos is not None:
+            self._moos.close()
+            self._moos = None
         self.web.stop()
         super().close()
 

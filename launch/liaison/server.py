@@ -26,9 +26,10 @@ from launch.liaison.errors import CommandRefused, LiaisonError
 from launch.liaison.fanout import MATCH_BUDGET_S, VIEWS, Browser
 from launch.liaison.form_values import build_command
 from launch.liaison.http_guard import SECURITY_HEADERS, HostGuard
-from launch.liaison.map_model import MapModel
+from launch.liaison.map_model import POLYGON_RADIUS_M, POLYGON_SIDES, USV_COMMAND_TYPE, MapModel
 from launch.liaison.name_filter import compile_filter
-from launch.liaison.page_messages import PageMessageError, encode, int_field, parse, str_field
+from launch.liaison.page_messages import PageMessageError, encode, float_field, int_field, parse, str_field
+from launch.liaison.replay import ReplayCache, ReplayError, ReplayLog, list_logs, resolve
 from launch.liaison.scope_model import ScopeModel
 from launch.liaison.settings import LiaisonSettings
 from util.ratelimit import RateLimitedLog
@@ -41,6 +42,9 @@ HISTORY_ITEMS_SENT = 100
 SEND_RATE_LIMIT = 20  # commands a page may send per second
 MAX_COMMENT_CHARS = 1000
 MAX_FILTER_CHARS = 256
+MAX_REPLAY_NAME_CHARS = 1024
+MAX_REPLAY_TRAIL_S = 86_400.0  # seconds of trail a replay frame may ask for
+MAX_LOG_TIME_S = 1e11  # a replay time (s since the epoch) beyond this is refused
 #: Publishes a command on the portal thread: (type, target, message, entry id) -> None; never blocks.
 Publish = Callable[[CommandType, Target, Any, int], None]
 
@@ -78,6 +82,9 @@ class WebServer:
         self.guard = HostGuard(settings.http_address, settings.allowed_hosts)
         self.refused_requests = 0  # HTTP/WebSocket requests refused for their Host or Origin
         self._notified: dict[int, int] = {}  # row id -> count when last notified
+        self._replay_cache = ReplayCache(settings.replay_max_samples)
+        self._replays: dict[Browser, ReplayLog] = {}  # the log each page replays
+        self._replay_loading: set[Browser] = set()
         self.ticks = 0
 
     # ------------------------------------------------------------------------------------- lifecycle
@@ -149,6 +156,7 @@ class WebServer:
         app.router.add_get("/ws", self._websocket)
         app.router.add_get("/api/urls", self._api_urls)
         app.router.add_get("/favicon.ico", self._favicon)
+        app.router.add_get("/map/background", self._background)
         app.router.add_static("/static/", STATIC_DIR, show_index=False)
         runner = web.AppRunner(app, handle_signals=False, access_log=None, shutdown_timeout=1.0)
         await runner.setup()
@@ -180,6 +188,13 @@ class WebServer:
 
     async def _favicon(self, request: web.Request) -> web.StreamResponse:
         return web.FileResponse(STATIC_DIR / "favicon.svg", headers={"Content-Type": "image/svg+xml"})
+
+    async def _background(self, request: web.Request) -> web.StreamResponse:
+        """The configured background image of the map (the only file served besides the page's own)."""
+        if self.settings.background is None:
+            raise web.HTTPNotFound(text="no background image is configured ([goby_moos_py.liaison.protobuf.web] "
+                                        "map.background)")
+        return web.FileResponse(self.settings.background.path, headers={"Cache-Control": "no-cache"})
 
     async def _api_urls(self, request: web.Request) -> web.Response:
         return web.json_response(self.urls)
@@ -233,6 +248,7 @@ class WebServer:
                 await browser.replies_drained()  # a page that sends but does not read is no longer read
         finally:
             self.browsers.discard(browser)
+            self._replays.pop(browser, None)
             sender.cancel()
         return ws
 
@@ -258,6 +274,8 @@ class WebServer:
             "subscribe": self._on_subscribe, "filter": self._on_filter, "pause": self._on_pause,
             "resume": self._on_resume, "expand": self._on_expand, "collapse": self._on_collapse,
             "send": lambda b, r: self._on_send(b, r, sent_times),
+            "replay_list": self._on_replay_list, "replay_open": self._on_replay_open,
+            "replay_seek": self._on_replay_seek, "replay_close": self._on_replay_close,
         }.get(op)
         if handler is None:
             self._reply(browser, "error", error=f"unknown op {op!r}")
@@ -309,6 +327,60 @@ class WebServer:
     def _on_collapse(self, browser: Browser, request: dict[str, Any]) -> None:
         browser.expanded.discard(int_field(request, "id"))
         self._reply(browser, "collapsed", id=request["id"])
+
+    # ------------------------------------------------------------------------------------------ replay
+    def _on_replay_list(self, browser: Browser, request: dict[str, Any]) -> None:
+        folders = self.settings.replay_dirs
+        self._reply(browser, "replay_list", logs=list_logs(folders), folders=[str(f) for f in folders])
+
+    def _on_replay_open(self, browser: Browser, request: dict[str, Any]) -> None:
+        name = str_field(request, "name", "", MAX_REPLAY_NAME_CHARS)
+        if browser in self._replay_loading:
+            raise ValueError("a log is being opened already: wait for it")
+        try:
+            path = resolve(self.settings.replay_dirs, name)
+        except ReplayError as exc:
+            self._reply(browser, "replay_error", error=str(exc))
+            return
+        self._replay_loading.add(browser)
+        asyncio.ensure_future(self._open_replay(browser, path, name))
+
+    async def _open_replay(self, browser: Browser, path: Path, name: str) -> None:
+        """Load a log on an executor thread (a large one must not stall the pages), then tell the page."""
+        try:
+            replay = await asyncio.get_running_loop().run_in_executor(None, self._replay_cache.load, path, name)
+        except ReplayError as exc:
+            self._reply(browser, "replay_error", error=str(exc))
+            return
+        except Exception as exc:  # noqa: BLE001 - a bug must cost one reply, not the server
+            log.exception("replay of %s failed", name)
+            self._reply(browser, "replay_error", error=f"{name}: {type(exc).__name__}: {exc}")
+            return
+        finally:
+            self._replay_loading.discard(browser)
+        if browser in self.browsers:
+            self._replays[browser] = replay
+            self._reply(browser, "replay_opened", **replay.summary())
+
+    def _on_replay_seek(self, browser: Browser, request: dict[str, Any]) -> None:
+        replay = self._replays.get(browser)
+        if replay is None:
+            raise ValueError("no log is open: send replay_open first")
+        when = float_field(request, "t", -MAX_LOG_TIME_S, MAX_LOG_TIME_S)
+        trail_s = float_field(request, "trail_s", 0.0, MAX_REPLAY_TRAIL_S) if "trail_s" in request else 600.0
+        self._reply(browser, "replay_frame", **replay.frame(when, trail_s))
+
+    def _on_replay_close(self, browser: Browser, request: dict[str, Any]) -> None:
+        self._replays.pop(browser, None)
+        self._reply(browser, "replay_closed")
+
+    def _map_command(self) -> dict[str, Any] | None:
+        """What the map's command tool sends: the commander's USVCommand type, its targets and DCCL bounds."""
+        kind = self.commander.types.get(USV_COMMAND_TYPE)
+        if kind is None or not kind.targets:
+            return None
+        return {"type": kind.name, "targets": [{"index": t.index, "label": t.label} for t in kind.targets],
+                "sides": list(POLYGON_SIDES), "radius": list(POLYGON_RADIUS_M)}
 
     def _on_send(self, browser: Browser, request: dict[str, Any], sent_times: list[float]) -> None:
         now = time.monotonic()
@@ -373,8 +445,9 @@ class WebServer:
     def _broadcast_sent(self, entries: list[SentCommand]) -> None:
         text = _json({"op": "sent", "entries": [e.view() for e in entries], "full": False})
         for browser in self.browsers:
-            if "commander" in browser.views:
-                browser.offer(text, "commander")
+            for view in ("commander", "map"):  # the map shows the last command's state beside the vehicle
+                if view in browser.views:
+                    browser.offer(text, view)
 
     def _send_full(self, browser: Browser, view: str, deadline: float | None = None) -> None:
         """A whole view; the scope waits for a later tick when matching its filters is over budget."""
@@ -390,7 +463,10 @@ class WebServer:
             browser.offer(_json({"op": "sent", "entries": [e.view() for e in self.commander.history],
                                  "full": True}), "commander")
         elif view == "map":
-            browser.offer(_json({"op": "map", "full": True, **self.map.snapshot()}), "map")
+            browser.offer(_json({"op": "map", "full": True, **self.map.snapshot(), "command": self._map_command(),
+                                 "replay": bool(self.settings.replay_dirs)}), "map")
+            last = [self.commander.history[-1]] if self.commander.history else []
+            browser.offer(_json({"op": "sent", "entries": [e.view() for e in last], "full": True}), "map")
         browser.needs_resync.discard(view)
 
     async def _ticker(self) -> None:

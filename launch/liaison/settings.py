@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from google.protobuf.message import Message
 
@@ -52,6 +53,32 @@ class LiaisonSettings:
     max_rows: int = 5000
     command_history: int = 200
     allowed_hosts: list[str] = field(default_factory=list)
+    initial_mode: str | None = None
+    datum: tuple[float, float] | None = None  # (lat, lon) of the local grid's origin
+    moos: MoosEndpoint | None = None
+    background: BackgroundImage | None = None
+    replay_dirs: list[Path] = field(default_factory=list)
+    replay_max_samples: int = 200_000
+
+
+@dataclass(frozen=True)
+class MoosEndpoint:
+    """The MOOSDB the map reads the helm's VIEW_* postings from."""
+
+    host: str
+    port: int
+    name: str
+
+
+@dataclass(frozen=True)
+class BackgroundImage:
+    """A configured image of the operating area and the lat/lon of its edges (pMarineViewer's .info)."""
+
+    path: Path
+    lat_north: float
+    lat_south: float
+    lon_east: float
+    lon_west: float
 
 
 def web_config(cfg: LiaisonConfig) -> WebConfig:
@@ -110,6 +137,9 @@ def _check_ranges(cfg: LiaisonConfig, extra: WebConfig) -> None:
     if not 1 <= cfg.pb_scope_config.max_history_items <= 100_000:
         raise LiaisonConfigError(f"pb_scope_config.max_history_items: {cfg.pb_scope_config.max_history_items} "
                                  "is outside [1, 100000]")
+    if not 1000 <= extra.map.replay_max_samples <= 10_000_000:
+        raise LiaisonConfigError(f"{WEB}.map.replay_max_samples: {extra.map.replay_max_samples} is outside "
+                                 "[1000, 10000000]")
     if not 2 <= extra.map.trail_points <= 100_000:
         raise LiaisonConfigError(f"{WEB}.map.trail_points: {extra.map.trail_points} is outside [2, 100000]")
     for name in ("waypoint", "loiter_polygon"):
@@ -119,6 +149,55 @@ def _check_ranges(cfg: LiaisonConfig, extra: WebConfig) -> None:
         for index, point in enumerate(points):
             if not (math.isfinite(point.x) and math.isfinite(point.y)):
                 raise LiaisonConfigError(f"{WEB}.map.{name}[{index}]: x and y must be finite numbers")
+
+
+MODES = ("POLYGON", "WAYPOINTS")
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".gif", ".webp")
+
+
+def _map_extras(extra: WebConfig) -> tuple[str | None, tuple[float, float] | None, MoosEndpoint | None,
+                                           BackgroundImage | None, list[Path]]:
+    """The map's optional settings, checked: (initial mode, datum, MOOSDB, background, replay folders)."""
+    cfg = extra.map
+    where = f"{WEB}.map"
+    mode = None
+    if cfg.HasField("initial_mode"):
+        mode = cfg.initial_mode.strip().upper()
+        if mode not in MODES:
+            raise LiaisonConfigError(f"{where}.initial_mode: {cfg.initial_mode!r} is not one of {', '.join(MODES)}")
+    datum = None
+    if cfg.HasField("datum_lat") != cfg.HasField("datum_lon"):
+        raise LiaisonConfigError(f"{where}: datum_lat and datum_lon go together")
+    if cfg.HasField("datum_lat"):
+        if not (-80.0 <= cfg.datum_lat <= 84.0 and -180.0 <= cfg.datum_lon <= 180.0):
+            raise LiaisonConfigError(f"{where}: datum {cfg.datum_lat}, {cfg.datum_lon} is outside UTM's range "
+                                     "(lat -80..84, lon -180..180)")
+        datum = (cfg.datum_lat, cfg.datum_lon)
+    moos = None
+    if cfg.HasField("moos"):
+        if not 1 <= cfg.moos.port <= 65535:
+            raise LiaisonConfigError(f"{where}.moos.port: {cfg.moos.port} is outside [1, 65535]")
+        moos = MoosEndpoint(cfg.moos.host, cfg.moos.port, cfg.moos.name)
+    background = None
+    if cfg.HasField("background"):
+        bg = cfg.background
+        path = Path(bg.image).expanduser()
+        if path.suffix.lower() not in IMAGE_SUFFIXES or not path.is_file():
+            raise LiaisonConfigError(f"{where}.background.image: {bg.image!r} is not an image file "
+                                     f"({', '.join(IMAGE_SUFFIXES)})")
+        numbers = (bg.lat_north, bg.lat_south, bg.lon_east, bg.lon_west)
+        if not (all(math.isfinite(v) for v in numbers) and -90 <= bg.lat_south < bg.lat_north <= 90
+                and -180 <= bg.lon_west < bg.lon_east <= 180):
+            raise LiaisonConfigError(f"{where}.background: need lat_south < lat_north and lon_west < lon_east, "
+                                     "in degrees")
+        background = BackgroundImage(path, *numbers)
+    replay_dirs = []
+    for index, folder in enumerate(cfg.replay_dir):
+        path = Path(folder).expanduser()
+        if path.exists() and not path.is_dir():  # one that does not exist yet may be made by the logger
+            raise LiaisonConfigError(f"{where}.replay_dir[{index}]: {folder!r} is not a folder")
+        replay_dirs.append(path.resolve())
+    return mode, datum, moos, background, replay_dirs
 
 
 def _host_name(host: str, index: int) -> str:
@@ -173,6 +252,7 @@ def load_settings(cfg: LiaisonConfig) -> LiaisonSettings:
         raise LiaisonConfigError(f"update_freq must be in (0, {MAX_UPDATE_FREQ:g}] Hz, not {cfg.update_freq:g}")
     _check_ranges(cfg, extra)
     allowed_hosts = [_host_name(h, index) for index, h in enumerate(extra.allowed_host)]
+    initial_mode, datum, moos, background, replay_dirs = _map_extras(extra)
     platform = cfg.interprocess.platform
     return LiaisonSettings(
         title=f"goby liaison: {platform}",
@@ -198,4 +278,10 @@ def load_settings(cfg: LiaisonConfig) -> LiaisonSettings:
         max_rows=extra.max_scope_rows,
         command_history=extra.command_history,
         allowed_hosts=allowed_hosts,
+        initial_mode=initial_mode,
+        datum=datum,
+        moos=moos,
+        background=background,
+        replay_dirs=replay_dirs,
+        replay_max_samples=extra.map.replay_max_samples,
     )

@@ -6,6 +6,7 @@ Set LIAISON_SCREENSHOT_DIR to keep the screenshots of the three views (docs/ hol
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import tempfile
@@ -17,6 +18,7 @@ import pytest
 from gateway.goby.acomms.udp_multicast import random_multicast
 from launch.liaison.testing import browser_skip_reason, chromium
 from launch.usv.analysis import command_effects
+from launch.usv.geometry import Polygon, parse_polygon
 from launch.usv.mission import UsvMission
 from launch.usv.settings import UsvSettings
 from util.process import free_port, wait_until
@@ -184,18 +186,67 @@ def test_topside_commander_sends_the_octagon_over_the_satellite_link(mission, br
     screenshot(browser, "topside_commander")
 
 
-def test_map_draws_the_vehicle_its_trail_and_the_overlays(mission, browser):
+def drawn(browser, what: str):
+    return browser.execute_script(f"return LiveMap.{what}")
+
+
+def test_map_draws_the_vehicle_its_trail_and_the_helms_overlays(mission, browser):
     browser.get(mission.urls["map"])
-    icon = wait_until(lambda: browser.find_elements("css selector", "#map-vehicles path.vehicle"), what="a vehicle")
-    assert icon[0].get_attribute("data-name") == "usv"
-    assert "rotate(" in icon[0].get_attribute("transform")
-    wait_until(lambda: len(browser.find_element("css selector", "#map-trails polyline").get_attribute("points").split())
-             > 3, what="a trail")
-    assert len(browser.find_element("id", "map-waypoints").get_attribute("points").split()) > 50
-    assert len(browser.find_element("id", "map-polygon").get_attribute("points").split()) in (6, 8)
+    wait_until(lambda: "usv" in drawn(browser, "drawn.vehicles"), what="the vehicle drawn")
+    assert drawn(browser, "vehicles.get('usv').data.type") == "USV"
+    wait_until(lambda: drawn(browser, "vehicles.get('usv').points.length") > 3, what="a trail")
+    assert len(drawn(browser, "overlays.waypoints")) > 50
+    # the mode and the loiter polygon are the helm's own (DEPLOY_STATE, VIEW_POLYGON from its MOOSDB)
+    wait_until(lambda: drawn(browser, "overlays.polygon_source") == "helm", what="the helm's VIEW_POLYGON")
+    assert browser.find_element("id", "map-mode").text == "POLYGON (from the helm's DEPLOY_STATE)"
+    assert len(drawn(browser, "drawn.polygon")) in (6, 8)
     # the vehicle's row says how long ago its last report arrived (a live vehicle: a few seconds at most)
     age = wait_until(lambda: browser.find_element("css selector", "#vehicle-table tbody tr td:nth-child(6)").text,
                      what="the last report's age")
     assert 0 <= int(age) < 30
     time.sleep(2)  # let the trail grow for the picture
     screenshot(browser, "map")
+
+
+def helm_polygon(mission) -> list[tuple[float, float]] | None:
+    """The vertices of the helm's last VIEW_POLYGON on the USV's MOOSDB."""
+    mission.poll()
+    views = mission.record.events_named("VIEW_POLYGON", source="moos")
+    polygon = parse_polygon(views[-1].value) if views else None
+    return [(round(x, 1), round(y, 1)) for x, y in polygon.vertices] if polygon else None
+
+
+def test_a_polygon_drawn_on_the_map_is_acked_drawn_where_the_helm_has_it_and_changes_the_track(mission, browser):
+    """POLYGON while already in POLYGON: the page draws the ring where the helm keeps it (its VIEW_POLYGON), not
+    re-centred on the vehicle; the command goes through the commander's path (its ack) and the boat follows."""
+    browser.get(mission.urls["map"])
+    wait_until(lambda: drawn(browser, "overlays.polygon_source") == "helm" and drawn(browser, "command"),
+               what="the map with the helm's polygon and the command tool")
+    assert browser.find_element("id", "map-mode").text.startswith("POLYGON")  # already loitering
+    sides = browser.find_element("id", "map-sides")
+    sides.clear()
+    sides.send_keys("6")
+    radius = browser.find_element("id", "map-radius")
+    radius.clear()
+    radius.send_keys("700")
+    browser.find_element("id", "map-send-polygon").click()
+    cell = wait_until(lambda: (c := browser.find_element("css selector", "#vehicle-table tr[data-vehicle=usv] td:nth-child(8)"))
+                      and "acknowledged" in c.text and c, what="the command's ack beside the USV")
+    assert "polygon_radius: 700" in cell.text and "polygon_sides: 6" in cell.text
+
+    def helm_has_the_new_ring():
+        ring = helm_polygon(mission)
+        return ring if ring and len(ring) == 6 and abs(Polygon(tuple(ring)).mean_radius - 700) < 1 else None
+
+    ring = wait_until(helm_has_the_new_ring, what="the helm's VIEW_POLYGON of the new ring")
+    page = wait_until(lambda: (p := drawn(browser, "drawn.polygon")) and len(p) == 6 and p, what="the new ring drawn")
+    assert [tuple(p) for p in page] == ring  # the helm's own vertices, wherever the vehicle was
+    assert drawn(browser, "overlays.polygon_source") == "helm"
+    centre = Polygon(tuple(ring)).center
+
+    def on_the_new_ring():
+        x, y = drawn(browser, "drawn.vehicles")["usv"]
+        return math.hypot(x - centre[0], y - centre[1]) > 550 and Polygon(tuple(ring)).distance((x, y)) < 60
+
+    wait_until(on_the_new_ring, timeout=60, what="the USV out on the 700 m ring")
+    screenshot(browser, "map_command")

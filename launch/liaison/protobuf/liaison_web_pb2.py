@@ -25,7 +25,7 @@ _sym_db = _symbol_database.Default()
 from launch.liaison.protobuf import liaison_config_pb2 as launch_dot_liaison_dot_protobuf_dot_liaison__config__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n)launch/liaison/protobuf/liaison_web.proto\x12\x1dgoby_moos_py.liaison.protobuf\x1a,launch/liaison/protobuf/liaison_config.proto\"\x1d\n\x05Point\x12\t\n\x01x\x18\x01 \x02(\x01\x12\t\n\x01y\x18\x02 \x02(\x01\"\xbc\x01\n\tMapConfig\x12\x36\n\x08waypoint\x18\x01 \x03(\x0b\x32$.goby_moos_py.liaison.protobuf.Point\x12<\n\x0eloiter_polygon\x18\x02 \x03(\x0b\x32$.goby_moos_py.liaison.protobuf.Point\x12\x1e\n\x0f\x63\x65nter_activate\x18\x03 \x01(\x08:\x05\x66\x61lse\x12\x19\n\x0ctrail_points\x18\x04 \x01(\x05:\x03\x36\x30\x30\"\xcc\x01\n\x0fInterProcessAck\x12\x14\n\x0c\x63ommand_type\x18\x01 \x02(\t\x12\x10\n\x08\x61\x63k_type\x18\x02 \x02(\t\x12\x11\n\tack_group\x18\x03 \x02(\t\x12\x15\n\rcommand_field\x18\x04 \x02(\t\x12\x11\n\tack_field\x18\x05 \x02(\t\x12\x13\n\x0b\x66inal_field\x18\x06 \x01(\t\x12\x13\n\x0b\x66inal_value\x18\x07 \x03(\t\x12\x15\n\rrefused_value\x18\x08 \x01(\t\x12\x13\n\x07timeout\x18\t \x01(\x01:\x02\x31\x30\"\xb5\x02\n\tWebConfig\x12\x1a\n\x12load_python_module\x18\x01 \x03(\t\x12\x35\n\x03map\x18\x02 \x01(\x0b\x32(.goby_moos_py.liaison.protobuf.MapConfig\x12H\n\x10interprocess_ack\x18\x03 \x03(\x0b\x32..goby_moos_py.liaison.protobuf.InterProcessAck\x12 \n\x14\x63lient_queue_updates\x18\x04 \x01(\x05:\x02\x31\x36\x12\x17\n\x0bmax_clients\x18\x05 \x01(\x05:\x02\x36\x34\x12\x1c\n\x0emax_scope_rows\x18\x06 \x01(\x05:\x04\x35\x30\x30\x30\x12\x1c\n\x0f\x63ommand_history\x18\x07 \x01(\x05:\x03\x32\x30\x30\x12\x14\n\x0c\x61llowed_host\x18\x08 \x03(\t:`\n\x03web\x12(.goby.apps.zeromq.protobuf.LiaisonConfig\x18\x90N \x01(\x0b\x32(.goby_moos_py.liaison.protobuf.WebConfig')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n)launch/liaison/protobuf/liaison_web.proto\x12\x1dgoby_moos_py.liaison.protobuf\x1a,launch/liaison/protobuf/liaison_config.proto\"\x1d\n\x05Point\x12\t\n\x01x\x18\x01 \x02(\x01\x12\t\n\x01y\x18\x02 \x02(\x01\"\xa6\x03\n\tMapConfig\x12\x36\n\x08waypoint\x18\x01 \x03(\x0b\x32$.goby_moos_py.liaison.protobuf.Point\x12<\n\x0eloiter_polygon\x18\x02 \x03(\x0b\x32$.goby_moos_py.liaison.protobuf.Point\x12\x1e\n\x0f\x63\x65nter_activate\x18\x03 \x01(\x08:\x05\x66\x61lse\x12\x19\n\x0ctrail_points\x18\x04 \x01(\x05:\x03\x36\x30\x30\x12\x14\n\x0cinitial_mode\x18\x05 \x01(\t\x12\x11\n\tdatum_lat\x18\x06 \x01(\x01\x12\x11\n\tdatum_lon\x18\x07 \x01(\x01\x12\x35\n\x04moos\x18\x08 \x01(\x0b\x32\'.goby_moos_py.liaison.protobuf.MoosView\x12=\n\nbackground\x18\t \x01(\x0b\x32).goby_moos_py.liaison.protobuf.Background\x12\x12\n\nreplay_dir\x18\n \x03(\t\x12\"\n\x12replay_max_samples\x18\x0b \x01(\x05:\x06\x32\x30\x30\x30\x30\x30\"Q\n\x08MoosView\x12\x17\n\x04host\x18\x01 \x01(\t:\tlocalhost\x12\x0c\n\x04port\x18\x02 \x02(\r\x12\x1e\n\x04name\x18\x03 \x01(\t:\x10goby-liaison-map\"e\n\nBackground\x12\r\n\x05image\x18\x01 \x02(\t\x12\x11\n\tlat_north\x18\x02 \x02(\x01\x12\x11\n\tlat_south\x18\x03 \x02(\x01\x12\x10\n\x08lon_east\x18\x04 \x02(\x01\x12\x10\n\x08lon_west\x18\x05 \x02(\x01\"\xcc\x01\n\x0fInterProcessAck\x12\x14\n\x0c\x63ommand_type\x18\x01 \x02(\t\x12\x10\n\x08\x61\x63k_type\x18\x02 \x02(\t\x12\x11\n\tack_group\x18\x03 \x02(\t\x12\x15\n\rcommand_field\x18\x04 \x02(\t\x12\x11\n\tack_field\x18\x05 \x02(\t\x12\x13\n\x0b\x66inal_field\x18\x06 \x01(\t\x12\x13\n\x0b\x66inal_value\x18\x07 \x03(\t\x12\x15\n\rrefused_value\x18\x08 \x01(\t\x12\x13\n\x07timeout\x18\t \x01(\x01:\x02\x31\x30\"\xb5\x02\n\tWebConfig\x12\x1a\n\x12load_python_module\x18\x01 \x03(\t\x12\x35\n\x03map\x18\x02 \x01(\x0b\x32(.goby_moos_py.liaison.protobuf.MapConfig\x12H\n\x10interprocess_ack\x18\x03 \x03(\x0b\x32..goby_moos_py.liaison.protobuf.InterProcessAck\x12 \n\x14\x63lient_queue_updates\x18\x04 \x01(\x05:\x02\x31\x36\x12\x17\n\x0bmax_clients\x18\x05 \x01(\x05:\x02\x36\x34\x12\x1c\n\x0emax_scope_rows\x18\x06 \x01(\x05:\x04\x35\x30\x30\x30\x12\x1c\n\x0f\x63ommand_history\x18\x07 \x01(\x05:\x03\x32\x30\x30\x12\x14\n\x0c\x61llowed_host\x18\x08 \x03(\t:`\n\x03web\x12(.goby.apps.zeromq.protobuf.LiaisonConfig\x18\x90N \x01(\x0b\x32(.goby_moos_py.liaison.protobuf.WebConfig')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
@@ -35,9 +35,13 @@ if not _descriptor._USE_C_DESCRIPTORS:
   _globals['_POINT']._serialized_start=122
   _globals['_POINT']._serialized_end=151
   _globals['_MAPCONFIG']._serialized_start=154
-  _globals['_MAPCONFIG']._serialized_end=342
-  _globals['_INTERPROCESSACK']._serialized_start=345
-  _globals['_INTERPROCESSACK']._serialized_end=549
-  _globals['_WEBCONFIG']._serialized_start=552
-  _globals['_WEBCONFIG']._serialized_end=861
+  _globals['_MAPCONFIG']._serialized_end=576
+  _globals['_MOOSVIEW']._serialized_start=578
+  _globals['_MOOSVIEW']._serialized_end=659
+  _globals['_BACKGROUND']._serialized_start=661
+  _globals['_BACKGROUND']._serialized_end=762
+  _globals['_INTERPROCESSACK']._serialized_start=765
+  _globals['_INTERPROCESSACK']._serialized_end=969
+  _globals['_WEBCONFIG']._serialized_start=972
+  _globals['_WEBCONFIG']._serialized_end=1281
 # @@protoc_insertion_point(module_scope)

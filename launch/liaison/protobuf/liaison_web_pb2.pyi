@@ -54,10 +54,26 @@ class MapConfig(_message.Message):
     LOITER_POLYGON_FIELD_NUMBER: _builtins.int
     CENTER_ACTIVATE_FIELD_NUMBER: _builtins.int
     TRAIL_POINTS_FIELD_NUMBER: _builtins.int
+    INITIAL_MODE_FIELD_NUMBER: _builtins.int
+    DATUM_LAT_FIELD_NUMBER: _builtins.int
+    DATUM_LON_FIELD_NUMBER: _builtins.int
+    MOOS_FIELD_NUMBER: _builtins.int
+    BACKGROUND_FIELD_NUMBER: _builtins.int
+    REPLAY_DIR_FIELD_NUMBER: _builtins.int
+    REPLAY_MAX_SAMPLES_FIELD_NUMBER: _builtins.int
     center_activate: _builtins.bool
     """BHV_Loiter's center_activate: a polygon is drawn centred where the vehicle was when it became active."""
     trail_points: _builtins.int
     """points kept per vehicle (sampled at update_freq)"""
+    initial_mode: _builtins.str
+    """The helm's DEPLOY_STATE before any command (the USV starts in POLYGON); `moos` replaces it once connected."""
+    datum_lat: _builtins.float
+    """The local grid's datum (LatOrigin/LongOrigin) for the cursor's lat/lon; without it, derived from the first
+    NodeStatus that carries both a global and a local fix.
+    """
+    datum_lon: _builtins.float
+    replay_max_samples: _builtins.int
+    """NodeStatus samples kept from one log"""
     @_builtins.property
     def waypoint(self) -> _containers.RepeatedCompositeFieldContainer[Global___Point]:
         """the waypoint track to draw"""
@@ -66,6 +82,20 @@ class MapConfig(_message.Message):
     def loiter_polygon(self) -> _containers.RepeatedCompositeFieldContainer[Global___Point]:
         """the loiter polygon at start-up"""
 
+    @_builtins.property
+    def moos(self) -> Global___MoosView:
+        """The vehicle's MOOSDB, read as pMarineViewer reads it: VIEW_POLYGON, VIEW_SEGLIST, VIEW_POINT and DEPLOY_STATE
+        are what the helm has (drawn instead of what was commanded).
+        """
+
+    @_builtins.property
+    def background(self) -> Global___Background:
+        """A background image (pMarineViewer's .tif + .info): served by the liaison itself, never fetched elsewhere."""
+
+    @_builtins.property
+    def replay_dir(self) -> _containers.RepeatedScalarFieldContainer[_builtins.str]:
+        """Folders whose .goby logs the page may replay (by file name only: the page never names a path)."""
+
     def __init__(
         self,
         *,
@@ -73,14 +103,78 @@ class MapConfig(_message.Message):
         loiter_polygon: _abc.Iterable[Global___Point] | None = ...,
         center_activate: _builtins.bool | None = ...,
         trail_points: _builtins.int | None = ...,
+        initial_mode: _builtins.str | None = ...,
+        datum_lat: _builtins.float | None = ...,
+        datum_lon: _builtins.float | None = ...,
+        moos: Global___MoosView | None = ...,
+        background: Global___Background | None = ...,
+        replay_dir: _abc.Iterable[_builtins.str] | None = ...,
+        replay_max_samples: _builtins.int | None = ...,
     ) -> None: ...
-    _HasFieldArgType: _TypeAlias = _typing.Literal["center_activate", b"center_activate", "trail_points", b"trail_points"]  # noqa: Y015
+    _HasFieldArgType: _TypeAlias = _typing.Literal["background", b"background", "center_activate", b"center_activate", "datum_lat", b"datum_lat", "datum_lon", b"datum_lon", "initial_mode", b"initial_mode", "moos", b"moos", "replay_max_samples", b"replay_max_samples", "trail_points", b"trail_points"]  # noqa: Y015
     def HasField(self, field_name: _HasFieldArgType) -> _builtins.bool: ...
-    _ClearFieldArgType: _TypeAlias = _typing.Literal["center_activate", b"center_activate", "loiter_polygon", b"loiter_polygon", "trail_points", b"trail_points", "waypoint", b"waypoint"]  # noqa: Y015
+    _ClearFieldArgType: _TypeAlias = _typing.Literal["background", b"background", "center_activate", b"center_activate", "datum_lat", b"datum_lat", "datum_lon", b"datum_lon", "initial_mode", b"initial_mode", "loiter_polygon", b"loiter_polygon", "moos", b"moos", "replay_dir", b"replay_dir", "replay_max_samples", b"replay_max_samples", "trail_points", b"trail_points", "waypoint", b"waypoint"]  # noqa: Y015
     def ClearField(self, field_name: _ClearFieldArgType) -> None: ...
     def WhichOneof(self, oneof_group: _Never) -> None: ...
 
 Global___MapConfig: _TypeAlias = MapConfig  # noqa: Y015
+
+@_typing.final
+class MoosView(_message.Message):
+    DESCRIPTOR: _descriptor.Descriptor
+
+    HOST_FIELD_NUMBER: _builtins.int
+    PORT_FIELD_NUMBER: _builtins.int
+    NAME_FIELD_NUMBER: _builtins.int
+    host: _builtins.str
+    port: _builtins.int
+    name: _builtins.str
+    def __init__(
+        self,
+        *,
+        host: _builtins.str | None = ...,
+        port: _builtins.int | None = ...,
+        name: _builtins.str | None = ...,
+    ) -> None: ...
+    _HasFieldArgType: _TypeAlias = _typing.Literal["host", b"host", "name", b"name", "port", b"port"]  # noqa: Y015
+    def HasField(self, field_name: _HasFieldArgType) -> _builtins.bool: ...
+    _ClearFieldArgType: _TypeAlias = _typing.Literal["host", b"host", "name", b"name", "port", b"port"]  # noqa: Y015
+    def ClearField(self, field_name: _ClearFieldArgType) -> None: ...
+    def WhichOneof(self, oneof_group: _Never) -> None: ...
+
+Global___MoosView: _TypeAlias = MoosView  # noqa: Y015
+
+@_typing.final
+class Background(_message.Message):
+    DESCRIPTOR: _descriptor.Descriptor
+
+    IMAGE_FIELD_NUMBER: _builtins.int
+    LAT_NORTH_FIELD_NUMBER: _builtins.int
+    LAT_SOUTH_FIELD_NUMBER: _builtins.int
+    LON_EAST_FIELD_NUMBER: _builtins.int
+    LON_WEST_FIELD_NUMBER: _builtins.int
+    image: _builtins.str
+    """a PNG or JPEG file on the liaison's host"""
+    lat_north: _builtins.float
+    lat_south: _builtins.float
+    lon_east: _builtins.float
+    lon_west: _builtins.float
+    def __init__(
+        self,
+        *,
+        image: _builtins.str | None = ...,
+        lat_north: _builtins.float | None = ...,
+        lat_south: _builtins.float | None = ...,
+        lon_east: _builtins.float | None = ...,
+        lon_west: _builtins.float | None = ...,
+    ) -> None: ...
+    _HasFieldArgType: _TypeAlias = _typing.Literal["image", b"image", "lat_north", b"lat_north", "lat_south", b"lat_south", "lon_east", b"lon_east", "lon_west", b"lon_west"]  # noqa: Y015
+    def HasField(self, field_name: _HasFieldArgType) -> _builtins.bool: ...
+    _ClearFieldArgType: _TypeAlias = _typing.Literal["image", b"image", "lat_north", b"lat_north", "lat_south", b"lat_south", "lon_east", b"lon_east", "lon_west", b"lon_west"]  # noqa: Y015
+    def ClearField(self, field_name: _ClearFieldArgType) -> None: ...
+    def WhichOneof(self, oneof_group: _Never) -> None: ...
+
+Global___Background: _TypeAlias = Background  # noqa: Y015
 
 @_typing.final
 class InterProcessAck(_message.Message):
