@@ -253,8 +253,7 @@ class UsvTarget(_MissionTarget[UsvMission]):
         self.probe_ipc_base = self.settings.ipc_base
 
     def poll(self) -> None:
-        assert self.mission.moos is not None  # start() made it
-        self.mission.moos.poll()
+        self.mission.poll_logs()
 
     def _group(self) -> ProcessGroup:
         assert self.mission.group is not None
@@ -318,7 +317,7 @@ class TrailTarget(_MissionTarget[TrailMission]):
         """Every vehicle with a MOOSDB has had a NAV fix since the kill (the USV's is also the probe's)."""
         for run in self.mission.runs.values():
             nav, _ = run.record.snapshot()
-            if run.moos is not None and (not nav or nav[-1].t <= self._killed_sim_t):
+            if run.logs.moos and (not nav or nav[-1].t <= self._killed_sim_t):
                 return False
         return last_nav > kill.at
 

@@ -108,8 +108,7 @@ def _cpu_and_rss(pids: list[int]) -> tuple[float, int]:
 def measure(n_auvs: int, warp: int, sim_seconds: float) -> dict[str, object]:
     run_dir = Path(tempfile.mkdtemp(prefix=f"fleet{n_auvs}-", dir="/tmp"))
     settings = with_free_ports(TrailSettings(run_dir=run_dir, warp=warp), n_auvs, prefer_course=False)
-    # the benchmark's own recorder stays light (one variable per vehicle): at 16 AUVs a full recorder in one Python
-    # process falls silent under load and the MOOSDBs drop it
+    # the benchmark reads only NAV_X/NAV_Y from each vehicle's alog as it grows (moos-logger's, as the demo does)
     mission = TrailMission(settings, n_auvs, report=lambda line: None, launch_delay_s=1.0, moos_variables=("NAV_X", "NAV_Y"))
     links = LinkMonitor(settings, n_auvs)
     mission.add_hook(links.poll)
@@ -126,7 +125,7 @@ def measure(n_auvs: int, warp: int, sim_seconds: float) -> dict[str, object]:
         since = _uptime()
         pids0 = _cpu_by_pid(all0)
         programs0 = _cpu_by_program(all0)
-        nav0 = {name: run.moos.counts["NAV_X"] for name, run in mission.runs.items() if run.moos is not None}
+        nav0 = {name: run.logs.counts.get("NAV_X", 0) for name, run in mission.runs.items() if run.logs.moos}
         real0, sim0, machine0 = time.monotonic(), mission.now(), _machine_ticks()
         mission.run(None, until=lambda: mission.now() - sim0 >= sim_seconds)
         real, sim, machine1 = time.monotonic() - real0, mission.now() - sim0, _machine_ticks()
@@ -140,8 +139,8 @@ def measure(n_auvs: int, warp: int, sim_seconds: float) -> dict[str, object]:
         row["cpu_per_sim_s"] = cpu / sim
         row["core_share"] = cpu / real / (os.cpu_count() or 1)
         row["rss_mb_per_vehicle"] = sum(r for _, r in per_platform.values()) / len(per_platform) / 2**20
-        rates = [(run.moos.counts["NAV_X"] - nav0[name]) / sim for name, run in mission.runs.items()
-                 if run.moos is not None]
+        rates = [(run.logs.counts.get("NAV_X", 0) - nav0[name]) / sim for name, run in mission.runs.items()
+                 if run.logs.moos]
         row["nav_per_sim_s_min"] = min(rates) if rates else float("nan")
         row["kept_up"] = bool(rates) and min(rates) > 0.9
         row["sat_satellite"] = links.stats["satellite"].saturation(sim)

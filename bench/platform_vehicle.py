@@ -8,8 +8,9 @@ generate from ``UsvSettings``. The C++ vehicle is the same lines with Goby3's an
 ``goby_frontseat_interface_basic_simulator`` wrapper runs), without our driver's ``--frontseat_cfg`` tuning.
 The interface's config holds Goby3's fields only, so both sides read the same files.
 
-A MOOS client (``launch.recorder.MoosRecorder``) counts NAV_X and DESIRED_SPEED and keeps the track and the helm
-state, so the benchmark can tell that a vehicle really runs. Programs of the C++ side are looked up in
+A MOOS client of the benchmark's own (:class:`MoosWatch`) counts NAV_X and DESIRED_SPEED and keeps the track and
+the helm state, so the benchmark can tell that a vehicle really runs (the vehicle's five processes do not include
+the missions' loggers, so it cannot read their logs). Programs of the C++ side are looked up in
 ``$GOBY_BIN_DIR``, ``$MOOS_IVP_BIN`` and then PATH.
 """
 
@@ -23,17 +24,19 @@ import shutil
 import sys
 import tempfile
 import time
+from collections import Counter
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 from bench.platform_proc import ProcSample, children_by_parent, sample_tree
+from gateway.moos import MoosClock, comms
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import LaunchEntry, expand_vars, parse_file
 from launch.process_group import ProcessGroup, child_environment
 from launch.record import MissionRecord
-from launch.recorder import MoosRecorder, SimClock
+from launch.recorder import SimClock
 from launch.usv.settings import UsvSettings
 from util.process import free_port
 
@@ -44,6 +47,33 @@ WATCHED = ("NAV_X", "NAV_Y", "DESIRED_SPEED", "DESIRED_HEADING", "IVPHELM_STATE"
 BASIC_SIMULATOR_DRIVER = "libgoby_frontseat_basic_simulator.so"
 READY_TIMEOUT_S = 180.0  # launch to moving under helm command, on a loaded machine
 GOBY_SOVERSION = "30"  # Goby3 3.x: the soname the generated goby_frontseat_interface_basic_simulator names
+
+
+class MoosWatch:
+    """A MOOS client registered for :data:`WATCHED`; ``poll()`` (the benchmark's thread) counts the mail and files
+    the track and the helm state into the record. Its own I/O thread only queues mail (the pymoos contract)."""
+
+    def __init__(self, record: MissionRecord, clock: SimClock, moos_port: int, name: str) -> None:
+        self.record, self.clock, self.moos_port, self.name = record, clock, moos_port, name
+        self.comms = comms(clock=MoosClock(clock.warp))
+        self.comms.set_on_connect_callback(lambda: all(self.comms.register(v, 0) for v in WATCHED))
+        self.counts: Counter[str] = Counter()
+
+    def start(self) -> None:
+        self.comms.run("127.0.0.1", self.moos_port, self.name)
+
+    def poll(self) -> None:
+        now = self.clock.now()
+        for msg in self.comms.fetch():
+            name = msg.key()
+            self.counts[name] += 1
+            if name in ("NAV_X", "NAV_Y") and msg.is_double():
+                self.record.add_nav(now, name, msg.double())
+            elif name == "IVPHELM_STATE":
+                self.record.add_event(now, "moos", name, msg.string(), msg.source())
+
+    def close(self) -> None:
+        self.comms.close(True)
 
 
 @dataclass(frozen=True)
@@ -180,8 +210,7 @@ class Vehicle:
         self.group = ProcessGroup([entry for _, entry in selected], settings.log_dir, platform=side,
                                   launch_delay_s=launch_delay_s, kill_timeout_s=5.0, base_env=env, cwd=settings.run_dir,
                                   report=log.info)
-        self.moos = MoosRecorder(self.record, self.clock, settings.moos_port, name=f"uBench_{side}",
-                                 variables=WATCHED)
+        self.moos = MoosWatch(self.record, self.clock, settings.moos_port, name=f"uBench_{side}")
 
     def start(self) -> None:
         """Start the processes (the MOOS client connects once the MOOSDB is up)."""
