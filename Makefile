@@ -1,5 +1,6 @@
 # Two commands: `make demo` runs the trail mission (topside, USV, 4 AUVs) on embedded defaults (`make demo
-# MISSION=usv`: the USV mission alone); `make test` passes the tests.
+# MISSION=usv`: the USV mission alone); every platform logs (goby-logger, moos-logger) and the demo ends by printing
+# where the logs are and the command that exports them to MCAP (docs/logging.md); `make test` passes the tests.
 # Each creates its own virtual environment in .venv on first use.
 PYTHON ?= python3
 VENV := .venv

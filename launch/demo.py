@@ -7,12 +7,15 @@ the mission's run under SIGINT/SIGTERM handling, and ``main``.
 from __future__ import annotations
 
 import argparse
+import importlib
+import shlex
 import shutil
 import sys
 import tempfile
 import threading
 from collections.abc import Callable
 from pathlib import Path
+from types import ModuleType
 from typing import Protocol, TypeVar
 
 from launch.errors import LaunchError, MissionConfigError
@@ -28,6 +31,19 @@ class Mission(Protocol[ResultT]):
     stop_event: threading.Event
 
     def stop(self, failure: str | None = None) -> ResultT: ...
+
+
+def plotting(module: str, picture: str) -> ModuleType:
+    """A demo's plot module, imported only when a run needs it: matplotlib is the optional ``[demo]`` extra, so
+    ``--help`` and bad arguments work without it. Raises :class:`LaunchError` naming the extra when it is missing
+    (call it before any process starts: no mission run that cannot draw its ``picture``)."""
+    try:
+        return importlib.import_module(module)
+    except ModuleNotFoundError as exc:
+        if (exc.name or "").partition(".")[0] != "matplotlib":
+            raise
+        raise LaunchError(f"the demo draws {picture} with matplotlib, which is not installed: install the [demo] "
+                          f"extra ({shlex.quote(sys.executable)} -m pip install -e '.[demo]', or run make demo)") from None
 
 
 def whole_number(low: int, high: int | None = None) -> Callable[[str], int]:

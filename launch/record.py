@@ -1,8 +1,7 @@
-"""What the demo saw during a mission, in sim seconds: the track and every interesting posting.
+"""What a mission did, in sim seconds: the track and every interesting posting.
 
-The recorder (``launch.recorder``) fills a ``MissionRecord`` from MOOS mail and portal messages;
-``launch.usv.analysis`` and ``launch.usv.plot`` read it. Kept free of I/O so analyses are testable
-with hand-made records.
+``launch.recorder`` fills a ``MissionRecord`` from the mission's logs (goby-logger's .goby, moos-logger's .alog);
+the analyses and pictures read it. Kept free of I/O so analyses are testable with hand-made records.
 """
 
 from __future__ import annotations
@@ -11,6 +10,39 @@ import csv
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
+
+#: The modules of the missions' own messages (the course's, the frontseat's, and every application's configuration,
+#: which each publishes on ``goby::configuration``): goby-logger imports them (``load_shared_library``) so its logs
+#: describe every type they hold (the MCAP export decodes everything), and the demos' log reader decodes with them.
+PROTO_MODULES = (
+    "frontseat.protobuf.frontseat_pb2",
+    "frontseat.protobuf.frontseat_data_pb2",
+    "frontseat.protobuf.navigation_pb2",
+    "translators.trail.protobuf.nav_dccl_pb2",
+    "translators.trail.protobuf.health_status_pb2",
+    "translators.usv.protobuf.command_dccl_pb2",
+    "translators.usv.protobuf.command_ack_pb2",
+    "gateway.goby.intervehicle.protobuf.intervehicle_pb2",
+    "gateway.goby.portal.protobuf.coroner_pb2",
+    # configurations
+    "frontseat.protobuf.frontseat_interface_config_pb2",
+    "frontseat.protobuf.opencpn_config_pb2",
+    "gateway.goby.portal.protobuf.coroner_config_pb2",
+    "gateway.goby.portal.protobuf.gobyd_config_pb2",
+    "gateway.goby.portal.protobuf.terminate_config_pb2",
+    "gateway.moos_gateway.protobuf.moos_gateway_config_pb2",
+    "launch.liaison.protobuf.liaison_config_pb2",
+    "translators.trail.protobuf.health_monitor_config_pb2",
+    "translators.trail.protobuf.manager_config_pb2",
+    "translators.usv.protobuf.usv_config_pb2",
+    "behaviors.protobuf.goby_helm_example_config_pb2",
+)
+
+
+def load_shared_library_lines() -> str:
+    """goby-logger's ``load_shared_library`` lines for :data:`PROTO_MODULES`."""
+    return "\n".join(f'load_shared_library: "{module}"' for module in PROTO_MODULES)
+
 
 #: Where ``MissionRecord.add_nav`` keeps each NAV_* variable's latest value.
 _NAV_ATTRIBUTES = {"NAV_X": "_x", "NAV_Y": "_y", "NAV_HEADING": "_heading", "NAV_SPEED": "_speed", "NAV_DEPTH": "_depth"}
@@ -71,6 +103,13 @@ class MissionRecord:
         with self._lock:
             self.events.append(Event(t, source, name, value, origin))
 
+    def sort(self) -> None:
+        """Put the track and the events in time order (stable: same-time items keep their order), for a record
+        filled from several logs."""
+        with self._lock:
+            self.nav.sort(key=lambda s: s.t)
+            self.events.sort(key=lambda e: e.t)
+
     def snapshot(self) -> tuple[list[NavSample], list[Event]]:
         with self._lock:
             return list(self.nav), list(self.events)
@@ -102,6 +141,15 @@ class MissionRecord:
 
 def _fmt(value: float | None) -> str:
     return "" if value is None else f"{value:.2f}"
+
+
+def until(record: MissionRecord, end: float) -> MissionRecord:
+    """A copy without what came after ``end`` (the logs go on while the processes stop)."""
+    nav, events = record.snapshot()
+    out = MissionRecord()
+    out.nav = [s for s in nav if s.t <= end]
+    out.events = [e for e in events if e.t <= end]
+    return out
 
 
 def shifted(record: MissionRecord, dt: float) -> MissionRecord:

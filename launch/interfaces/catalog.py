@@ -18,12 +18,12 @@ SHIPPED_APPLICATIONS: dict[str, list[str]] = {
     "topside-manager": ["translators.apps.topside_manager", "translators.trail.topside_manager"],
     "usv-health-monitor": ["translators.apps.usv_health_monitor"],
     "goby-coroner": ["gateway.apps.goby_coroner"],
+    "goby-opencpn-interface": ["frontseat.apps.goby_opencpn_interface"],
     "moos-gateway-frontseat-plugin": ["translators.frontseat.translation"],
     "moos-gateway-usv-command-plugin": ["translators.usv.command_translation"],
     "moos-gateway-node-report-plugin": ["translators.node_report"],
     "goby-helm-example": ["behaviors.apps.goby_helm_example"],
     "usv-mission-shore": ["launch.usv.shore"],
-    "usv-mission-recorder": ["launch.recorder"],
     "trail-mission-operator": ["launch.trail.operator"],
     "moos-gateway-goby3-course-plugin": ["translators.trail.ivp_helm_translation", "translators.usv.command_translation"],
 }

@@ -31,6 +31,7 @@ from launch.config import (
     text_format_string,
 )
 from launch.errors import MissionConfigError
+from launch.record import load_shared_library_lines
 from launch.trail.settings import (
     MULTICAST_ADDRESS,
     REPO_ROOT,
@@ -43,8 +44,11 @@ from launch.trail.settings import (
     satellite_mac_slots,
     vehicle_from_env,
 )
+from launch.usv.settings import USV_DIR
 
 TEMPLATES = TRAIL_DIR / "templates"
+# goby-coroner and usv-health-monitor: the USV mission's templates, one list of expected names for both missions
+USV_TEMPLATES = USV_DIR / "templates"
 
 USV_BHV = REPO_ROOT / "behaviors" / "usv.bhv"
 AUV_BHV_TEMPLATE = REPO_ROOT / "behaviors" / "auv.bhv.in"
@@ -60,6 +64,8 @@ ALIASES = {
     "goby3_course_auv_manager": "auv_manager",
     "goby3_course_topside_manager": "topside_manager",
     "goby3_course_helm": "helm",
+    "goby3_course_usv_health_monitor": "usv_health_monitor",
+    "goby_opencpn_interface": "opencpn_interface",
 }
 
 
@@ -83,6 +89,8 @@ def _values(settings: TrailSettings, vehicle: Vehicle, app: str) -> dict[str, ob
         "liaison_port": vehicle.liaison_port(settings),
         "east_duration": settings.east_duration,
         "south_duration": settings.south_duration,
+        "ais_address": text_format_string(settings.ais_address),
+        "ais_port": settings.ais_port,
     }
     values["app_block"] = render(SHARED_TEMPLATES / "_app.pb.cfg.in", values)
     values["interprocess_block"] = (render(SHARED_TEMPLATES / "_interprocess.pb.cfg.in", values)
@@ -102,9 +110,9 @@ def _tcp_interprocess(settings: TrailSettings, vehicle: Vehicle) -> str:
 }}"""
 
 
-def _pb(template: str, app: str) -> Callable[[TrailSettings, Vehicle], str]:
+def _pb(template: str, app: str, directory: Path = TEMPLATES) -> Callable[[TrailSettings, Vehicle], str]:
     def generate(settings: TrailSettings, vehicle: Vehicle) -> str:
-        path = TEMPLATES / template
+        path = directory / template
         return render(path if path.is_file() else SHARED_TEMPLATES / template, _values(settings, vehicle, app))
 
     return generate
@@ -226,6 +234,28 @@ def _liaison(settings: TrailSettings, vehicle: Vehicle) -> str:
     return render(TEMPLATES / "liaison.pb.cfg.in", values)
 
 
+def _liaison_web(settings: TrailSettings, vehicle: Vehicle) -> str:
+    """goby-liaison's own map settings (``--web``): the datum for the cursor's lat/lon, this run's logs for replay,
+    and on a vehicle its MOOSDB, so the map draws the helm's own VIEW_* and DEPLOY_STATE. The topside has no
+    MOOSDB: it starts from the USV's initial DEPLOY_STATE (usv.bhv's POLYGON) and models what it commands."""
+    lines = [f"datum_lat: {settings.lat_origin!r}", f"datum_lon: {settings.lon_origin!r}",
+             f"replay_dir: {text_format_string(str(settings.run_dir / 'logs'))}"]
+    if vehicle.kind in ("topside", "usv") and settings.usv_helm == "ivp":
+        lines += ["center_activate: true", 'initial_mode: "POLYGON"']
+    if vehicle.kind != "topside":
+        lines.append(f'moos {{ host: {text_format_string(settings.moos_address)} port: {vehicle.moos_port(settings)} }}')
+    return "map {\n  " + "\n  ".join(lines) + "\n}\n"
+
+
+def _goby_logger(settings: TrailSettings, vehicle: Vehicle) -> str:
+    """goby-logger (the course's post-homework-4 goby_logger): the platform's broker into
+    ``<run_dir>/logs/<platform>/<platform>_<time>.goby``, next to the moos-logger's .alog directory."""
+    values = _values(settings, vehicle, "goby-logger")
+    values["data_log_dir"] = vehicle.log_dir(settings)
+    values["load_shared_library"] = load_shared_library_lines()
+    return render(SHARED_TEMPLATES / "goby_logger.pb.cfg.in", values)
+
+
 def _vehicle_only(
     kinds: tuple[str, ...], app: str, generate: Callable[[TrailSettings, Vehicle], str]
 ) -> Callable[[TrailSettings, Vehicle], str]:
@@ -251,7 +281,9 @@ def bhv_text(settings: TrailSettings, vehicle: Vehicle) -> str:
 def moos_text(settings: TrailSettings, vehicle: Vehicle) -> str:
     values = _values(settings, vehicle, "moos")
     values["community"] = vehicle.community
+    values["data_log_dir"] = vehicle.log_dir(settings)
     values["bhv_file"] = vehicle.bhv_file(settings)
+    values["share_block"] = _share_block(settings, vehicle)
     domains = ["course:0:359:360", "speed:0:2:41"] if vehicle.kind == "usv" else \
         ["course:0:359:360", "speed:0:4:41", "depth:0:200:201"]
     values["domains"] = "\n".join(f"  domain = {d}" for d in domains)
@@ -268,6 +300,29 @@ def _write_atomic(path: Path, text: str) -> Path:
         out.write(text)
     os.replace(tmp, path)
     return path
+
+
+def _share_block(settings: TrailSettings, vehicle: Vehicle) -> str:
+    """moos-share's ``ProcessConfig = pShare`` (the course's pShare lines): each AUV sends its NODE_REPORT_LOCAL as
+    NODE_REPORT to the USV's input (``share_port_base`` + the USV's id, on ``usv_address``), which the USV binds.
+    At most ten a real second per AUV (moos-share's ``frequency`` is real time): node-reporter's rate at warp 1, as
+    the course shares every one; under warp node-reporter posts ten a sim second, hundreds a real second, and the
+    USV's MOOSDB would take them all for a display.
+    """
+    usv = Vehicle("usv", vehicle.n_auvs)
+    route = f"{settings.usv_address}:{usv.share_port(settings)}"
+    if vehicle.kind == "usv":
+        line = f"Input = route = {settings.usv_address}:{vehicle.share_port(settings)}"
+    else:
+        line = f"Output = src_name = NODE_REPORT_LOCAL, dest_name = NODE_REPORT, route = {route}, frequency = 10"
+    return f"""//------------------------------------------------------------
+// moos-share (pShare's role, docs/moos_share.md): the AUVs' NODE_REPORT_LOCAL reach the USV's MOOSDB as NODE_REPORT
+ProcessConfig = pShare
+{{
+  AppTick = 4
+  CommsTick = 4
+  {line}
+}}"""
 
 
 def write_moos_files(settings: TrailSettings, vehicle: Vehicle) -> tuple[Path, Path]:
@@ -301,6 +356,14 @@ GENERATORS: dict[str, Callable[[TrailSettings, Vehicle], str]] = {
     "usv_manager": _manager("usv-manager", "usv"),
     "auv_manager": _manager("auv-manager", "auv"),
     "liaison": _liaison,
+    "liaison_web": _liaison_web,  # given on goby-liaison's command line (--web), like the USV mission's
+    "goby_coroner": _vehicle_only(("usv",), "goby_coroner",
+                                  _pb("goby_coroner.pb.cfg.in", "goby-coroner", USV_TEMPLATES)),
+    "usv_health_monitor": _vehicle_only(("usv",), "usv_health_monitor",
+                                        _pb("usv_health_monitor.pb.cfg.in", "usv-health-monitor", USV_TEMPLATES)),
+    "opencpn_interface": _vehicle_only(("topside",), "opencpn_interface",
+                                       _pb("goby_opencpn_interface.pb.cfg.in", "goby-opencpn-interface")),
+    "goby_logger": _goby_logger,
     "helm": _vehicle_only(("usv",), "helm", _pb("helm.pb.cfg.in", "goby-helm-example")),
     "helm_command": _vehicle_only(("usv",), "helm_command", _helm_command),
     "commander": _vehicle_only(("topside",), "commander", _pb("commander.pb.cfg.in", "trail-commander")),

@@ -2,9 +2,11 @@
 
 Starts all.launch's platforms (topside, USV, N AUVs, each a nested goby-launch with generated configs), sends the
 USV commands from the topside over the satellite link (loiter on a hexagon, then the waypoints) and RECOVER from
-the USV over the acoustic link (or lets homework 3's helm send it, ``--usv-helm goby``), records every vehicle and
-both links, then writes ``trail.png``, ``trail_tracks.csv`` and ``trail_events.csv`` into the output directory and
-prints a summary. Exit status 0 only if the mission ran and every process stopped cleanly.
+the USV over the acoustic link (or lets homework 3's helm send it, ``--usv-helm goby``) and counts both links'
+datagrams. Every platform logs (goby-logger, moos-logger: ``<out>/run/logs/<platform>``); after the run the
+vehicles' tracks and events are read from those logs, ``trail.png``, ``trail_tracks.csv`` and ``trail_events.csv``
+are written into the output directory and a summary is printed, with where the logs are and the command that turns
+them into MCAP for Foxglove. Exit status 0 only if the mission ran and every process stopped cleanly.
 
 ``--acomms-loss 0.2 --acomms-delay 1-3 --satellite-loss 0.05 --satellite-outage 30`` impair the links: every
 modem driver of the link applies the channel to what it receives (our ``channel_model`` extension of the driver
@@ -29,22 +31,32 @@ from collections import Counter
 from pathlib import Path
 
 from gateway.goby.acomms.channel import MAX_DELAY_S, describe
-from launch.demo import add_run_arguments, demo_main, fresh_run_dir, run_mission, schedule_type, whole_number
+from launch.demo import (
+    add_run_arguments,
+    demo_main,
+    fresh_run_dir,
+    plotting,
+    run_mission,
+    schedule_type,
+    whole_number,
+)
 from launch.errors import LaunchError
 from launch.hosts import HostNetwork, unavailable
 from launch.mission import choose_program
 from launch.record import MissionRecord, shifted
+from launch.recorder import logs_lines
 from launch.trail.analysis import command_outcomes, recover_outcome, trail_performance
+from launch.trail.health_timeline import health_timeline_lines
 from launch.trail.links import LinkMonitor
 from launch.trail.mission import HostPlan, TrailMission, TrailResult, use_interprocess, with_free_ports
 from launch.trail.operator import SCHEDULE_HELP, Operator, PortalWorker, parse_trail_schedule
-from launch.trail.plot import write_trail_png
 from launch.trail.settings import CHANNEL_LINKS, TrailSettings, Vehicle, channel_text
 from launch.trail.summary import link_accounting, progress_line, summary_text
 from util.cli import HelpFormatter, bounded_number
 from util.logsetup import add_verbosity_argument
 
 log = logging.getLogger(__name__)
+PLOT = "launch.trail.plot"  # matplotlib: the [demo] extra, imported by plotting() when a run draws
 
 DEFAULT_AUVS = 4
 DEFAULT_WARP = 10
@@ -208,10 +220,12 @@ def report(result: TrailResult, operator: MissionRecord, n_auvs: int, links: Lin
         recovers = []  # no RECOVER in this run (homework helm not at its end, none scheduled)
     out.mkdir(parents=True, exist_ok=True)
     write_csvs(records, operator, out)
-    write_trail_png(out / "trail.png", records, commands, recovers, trails, title)
-    view = Counter(e.value for e in operator.events_named("node_status", "topside"))
+    plotting(PLOT, "trail.png").write_trail_png(out / "trail.png", records, commands, recovers, trails, title)
+    topside = records.get("topside")
+    view = Counter(e.value for e in topside.events_named("node_status", "topside")) if topside is not None else None
     return summary_text(result, trails, commands, recovers, None if links is None else links.stats, sim_seconds,
-                        None if links is None else links.error, dict(view), link_accounting(operator, n_auvs),
+                        None if links is None else links.error, None if view is None else dict(view),
+                        link_accounting(operator, n_auvs),
                         channels)
 
 
@@ -235,6 +249,7 @@ def _report(line: str) -> None:
 
 
 def run_demo(args: argparse.Namespace) -> int:
+    plotting(PLOT, "trail.png")  # before any process starts
     if args.split_usv and not args.hosts:
         raise LaunchError("--split-usv needs --hosts")
     if not args.hosts:
@@ -286,7 +301,6 @@ def _run_demo(args: argparse.Namespace, hosts: HostPlan | None) -> int:
                     use_interprocess(worker, hosts.interprocess(vehicle, settings))
         for worker in workers:
             worker.start()
-        topside.watch_node_status(operator_record, mission.clock)
         operator = Operator(plan, operator_record, mission.clock, topside, usv)
         mission.add_hook(operator.poll)
         print(f"all platforms up after {time.monotonic() - started:.0f} s; waiting for every vehicle to reach "
@@ -310,9 +324,11 @@ def _run_demo(args: argparse.Namespace, hosts: HostPlan | None) -> int:
     title = (f"Trail mission: USV ({args.usv_helm} helm) + {n} AUVs, {settings.helm} + {settings.moosdb}, "
              f"warp {settings.warp}, {sim_seconds:.0f} sim s")
     print(report(result, operator_record, n, links, sim_seconds, out, title, channels), flush=True)
+    print("\n".join(health_timeline_lines(result.logs, settings.warp, result.origin + result.t0)), flush=True)
     real = time.monotonic() - started
     print(f"wrote {out / 'trail.png'}, {out / 'trail_tracks.csv'} and {out / 'trail_events.csv'} "
           f"({real:.0f} s real time)")
+    print("\n".join(logs_lines(run_dir / "logs", [p for paths in result.logs.values() for p in paths])), flush=True)
     clean = all(o.clean for o in result.outcomes)
     return 0 if failure is None and clean and not result.deaths else 1
 

@@ -16,12 +16,20 @@ from launch.trail.generate_all_launch import DEFAULT_N_AUVS
 
 # (interface file stem, application it merges into or None) per platform kind
 PLATFORM_INTERFACES: dict[str, list[tuple[str, str | None]]] = {
-    "topside": [("topside-manager", None), ("trail-mission-operator", None)],
+    "topside": [("topside-manager", None), ("trail-mission-operator", None), ("goby-opencpn-interface", None)],
     # frontseat-interface's file includes the FrontSeatTranslation it runs (its moos_helm block), as Goby's does
     "usv": [("usv-manager", None), ("frontseat-interface", None),
-            ("moos-gateway-goby3-course-plugin", "moos-gateway"), ("goby-helm-example", None)],
+            ("moos-gateway-goby3-course-plugin", "moos-gateway"), ("goby-helm-example", None),
+            ("goby-coroner", None), ("usv-health-monitor", None)],
     "auv": [("auv-manager", None), ("frontseat-interface", None),
             ("moos-gateway-goby3-course-plugin", "moos-gateway")],
+}
+
+
+# MOOS processes (no Goby groups, so no interface file): named in the deployment as comments, per platform kind
+MOOS_SIDE: dict[str, str] = {
+    "usv": "moos-share (pShare's role, MOOS over UDP): receives every AUV's NODE_REPORT_LOCAL as NODE_REPORT",
+    "auv": "moos-share (pShare's role, MOOS over UDP): sends NODE_REPORT_LOCAL to the USV's MOOSDB as NODE_REPORT",
 }
 
 
@@ -50,6 +58,8 @@ def deployment_text(n_auvs: int = DEFAULT_N_AUVS) -> str:
                 lines.append(f"      - {stem}_interface.yml")
             else:
                 lines += [f"      - file: {stem}_interface.yml", f"        application: {application}"]
+        if kind in MOOS_SIDE:
+            lines.append(f"      # {MOOS_SIDE[kind]}")
     return "\n".join(lines) + "\n"
 
 

@@ -57,6 +57,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="with --part: the backseat computer's address (its broker's TCP transport and MOOSDB)")
     parser.add_argument("--broker-port", type=whole_number(1, 65535), default=TrailSettings.broker_port,
                         help=f"with --part: the broker's TCP port (default {TrailSettings.broker_port})")
+    parser.add_argument("--usv", type=_ipv4, default=None, metavar="ADDRESS",
+                        help="auv: the USV's (backseat) computer, where this AUV's moos-share sends its NODE_REPORTs "
+                        "(without it they are not shared)")
     parser.add_argument("--run-dir", default="/tmp/goby3_course_trail", help="where configs and logs go")
     parser.add_argument("--pages-on-address", action="store_true",
                         help="goby-liaison listens on --address (RISK: no login) instead of 127.0.0.1")
@@ -82,6 +85,11 @@ def platform_command(args: argparse.Namespace) -> tuple[dict[str, str], list[str
         env[N_AUVS_VAR] = str(args.auvs)
     if args.platform == "auv":
         env[AUV_INDEX_VAR] = str(args.index)
+        if args.usv is None:
+            print("host: no --usv: this AUV's NODE_REPORTs go to 127.0.0.1, not to the USV's MOOSDB", file=sys.stderr)
+        env["TRAIL_USV_ADDRESS"] = args.usv or "127.0.0.1"
+    if args.platform == "usv":  # its moos-share listens where its MOOSDB does
+        env["TRAIL_USV_ADDRESS"] = args.backseat if args.part else args.address
     if args.part:
         env |= {"TRAIL_BROKER_ADDRESS": args.backseat, "TRAIL_BROKER_PORT": str(args.broker_port)}
     TrailSettings.from_env(env)  # a bad value fails here, naming its variable, not in a launch line

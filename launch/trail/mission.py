@@ -1,10 +1,11 @@
-"""Run the trail mission (or one platform of it) from Python: its launch lines, a recorder per vehicle, the stop.
+"""Run the trail mission (or one platform of it) from Python: its launch lines, the stop, and its logs read.
 
 Used by the demo (``launch.trail.demo``), the mission test and the fleet benchmark, so all run exactly what
 ``./all.launch`` runs: the same nested ``goby-launch`` lines (``generate_all_launch.all_launch_text``) with the
-same generated configs. Each vehicle with a MOOSDB gets a MOOS client (track, helm and command variables) and a
-portal subscriber on its broker (the frontseat interface's state); all events share one clock, sim seconds since
-the recorders started, so vehicles and commands line up.
+same generated configs. Every platform runs goby-logger (and, with a MOOSDB, moos-logger) into its log directory
+(``<run_dir>/logs/<platform>``); the mission reads those logs as they grow (``PlatformLogs``: the wait for
+command, the progress lines) and, after the stop, whole (``TrailResult.records``). All times are sim seconds on
+the logs' time base (``launch.recorder``), so vehicles and commands line up.
 """
 
 from __future__ import annotations
@@ -28,8 +29,8 @@ from launch.launchfile import LaunchEntry, parse_file, parse_lines
 from launch.mission import ProcessOutcome, outcomes, scan_log_files
 from launch.portal_thread import BackgroundPortalThread
 from launch.process_group import ProcessGroup, child_environment
-from launch.record import MissionRecord, shifted
-from launch.recorder import MoosRecorder, PortalRecorder, SimClock
+from launch.record import MissionRecord, shifted, until
+from launch.recorder import PlatformLogs, SimClock, read_platform
 from launch.trail.generate_all_launch import all_launch_text
 from launch.trail.settings import AUV_INDEX_VAR, N_AUVS_VAR, TRAIL_DIR, TrailSettings, Vehicle
 
@@ -90,7 +91,8 @@ class HostPlan:
         host = self.hosts[launcher]
         vehicle_host = self.hosts["usv"] if launcher == USV_FRONTSEAT else host
         env = {"TRAIL_LINK_ADDRESS": host.address, "TRAIL_LIAISON_ADDRESS": host.address,
-               "TRAIL_MOOS_ADDRESS": vehicle_host.address, "TRAIL_LINK_PEERS": self.peers}
+               "TRAIL_MOOS_ADDRESS": vehicle_host.address, "TRAIL_LINK_PEERS": self.peers,
+               "TRAIL_USV_ADDRESS": self.hosts["usv"].address}  # where the AUVs' moos-share send NODE_REPORT
         if self.split_usv and launcher in ("usv", USV_FRONTSEAT):
             env |= {"TRAIL_BROKER_ADDRESS": vehicle_host.address, "TRAIL_BROKER_PORT": str(self.broker_port)}
         return env
@@ -127,21 +129,9 @@ def hosts_launch_entries(n_auvs: int, plan: HostPlan) -> list[LaunchEntry]:
     return entries
 
 
-class AddressedMoosRecorder(MoosRecorder):
-    """A MoosRecorder of a MOOSDB on another host (``MoosRecorder`` connects to 127.0.0.1)."""
-
-    def __init__(self, record: MissionRecord, clock: SimClock, address: str, moos_port: int, name: str,
-                 variables: tuple[str, ...] | None) -> None:
-        super().__init__(record, clock, moos_port, name=name, variables=variables)
-        self.address = address
-
-    def start(self) -> None:
-        self.comms.run(self.address, self.moos_port, self.name)
-
-
 def use_interprocess(thread: BackgroundPortalThread, cfg: InterProcessPortalConfig) -> None:
-    """Point a demo portal thread (PortalRecorder, PortalWorker: built with an IPC base) at ``cfg`` before it
-    starts. TODO(lead): an ``interprocess`` argument of those classes would replace this."""
+    """Point a demo portal thread (PortalWorker: built with an IPC base) at ``cfg`` before it starts.
+    TODO(lead): an ``interprocess`` argument of that class would replace this."""
     thread._cfg.interprocess.CopyFrom(cfg)  # type: ignore[attr-defined]
 
 
@@ -155,25 +145,30 @@ def _tcp_open(address: str, port: int) -> bool:
 
 @dataclass
 class VehicleRun:
-    """One vehicle's recorders and what they saw."""
+    """One vehicle's logs, read as they grow (``logs``), and what they held so far (``record``)."""
 
     vehicle: Vehicle
+    logs: PlatformLogs
     record: MissionRecord = field(default_factory=MissionRecord)
-    moos: MoosRecorder | None = None
-    portal: PortalRecorder | None = None
 
     def interface_states(self) -> list[str]:
         return [e.value for e in self.record.events_named("interface_state", source="interface")]
 
     def command_time(self) -> float | None:
-        return next((e.t for e in self.record.events_named("interface_state", source="interface")
-                     if e.value == COMMAND_STATE), None)
+        return command_time(self.record)
+
+
+def command_time(record: MissionRecord) -> float | None:
+    """When the vehicle's frontseat interface first reported COMMAND (None: never)."""
+    return next((e.t for e in record.events_named("interface_state", source="interface")
+                 if e.value == COMMAND_STATE), None)
 
 
 @dataclass
 class TrailResult:
-    """What the demo prints and the tests assert: per-vehicle records (t=0 when the last vehicle reached COMMAND),
-    how every launcher and process ended, unexpected error lines, and what failed."""
+    """What the demo prints and the tests assert: per-vehicle records read from the logs after the run (t=0 when the
+    last vehicle reached COMMAND), how every launcher and process ended, unexpected error lines, what failed, and
+    the log files read (``logs``: platform -> its .goby and .alog)."""
 
     records: dict[str, MissionRecord]
     command_times: dict[str, float | None]
@@ -182,6 +177,8 @@ class TrailResult:
     log_errors: list[str] = field(default_factory=list)
     failure: str | None = None
     deaths: list[tuple[float, str, str]] = field(default_factory=list)  # (t, launcher, log tail) with keep_going
+    logs: dict[str, list[Path]] = field(default_factory=dict)
+    origin: float = 0.0  # the mission clock's origin: t0 + origin is t=0 on the logs' time base (Unix time x warp)
 
 
 class TrailMission:
@@ -218,10 +215,16 @@ class TrailMission:
         # keep_going: a platform whose launcher dies (it stops its own processes first) is noted in ``deaths`` and
         # the other platforms run on; otherwise the first death ends the run.
         self.keep_going = keep_going
-        self.moos_variables = moos_variables  # what the MOOS recorders register for (None: track, helm, commands)
+        self.moos_variables = moos_variables  # the MOOS variables read from the alogs (None: track, helm, commands)
         self.deaths: list[tuple[float, str, str]] = []  # (sim time, launcher, last lines of its log)
         self.clock = SimClock(settings.warp)
-        self.runs = {v.name: VehicleRun(v) for v in (vehicles if vehicles is not None else fleet(n_auvs))}
+        self.runs = {}
+        for v in vehicles if vehicles is not None else fleet(n_auvs):
+            record = MissionRecord()
+            logs = PlatformLogs(v.log_dir(settings), v.name, settings.warp, record, moos=v.kind != "topside",
+                                moos_variables=moos_variables, node_status=v.kind == "topside",
+                                origin=self.clock.origin)
+            self.runs[v.name] = VehicleRun(v, logs, record)
         self.group: ProcessGroup | None = None
         self.log_dir = settings.run_dir / "logs" / "launch"
         # Set from any thread or a signal handler to end start-up, the wait for COMMAND, or the run.
@@ -241,7 +244,7 @@ class TrailMission:
         return env
 
     def start(self) -> None:
-        """Start the MOOS recorders (they retry until their MOOSDB is up), the launch lines, then the portal ones."""
+        """Start the launch lines (the loggers among them) and wait for every broker."""
         self.settings.run_dir.mkdir(parents=True, exist_ok=True)
         self.group = ProcessGroup(
             self.entries,
@@ -255,24 +258,11 @@ class TrailMission:
             parallel_stop=True,
         )
         self.group.stop_event = self.stop_event
-        for run in self.runs.values():
-            if run.vehicle.kind != "topside":
-                name, port = f"uTrailRecorder_{run.vehicle.name}", run.vehicle.moos_port(self.settings)
-                run.moos = (MoosRecorder(run.record, self.clock, port, name=name, variables=self.moos_variables)
-                            if self.hosts is None else
-                            AddressedMoosRecorder(run.record, self.clock, self.hosts.address(run.vehicle), port, name,
-                                                  self.moos_variables))
-                run.moos.start()
-        self.group.on_wait = self.poll_moos
+        self.group.on_wait = self.poll_logs
         self.group.start()
-        # The outer launch returns once the inner launchers run; their brokers come up a little later.
+        # The outer launch returns once the inner launchers run; their brokers come up a little later (the demo's
+        # portal threads need them).
         self.wait_for_brokers()
-        for run in self.runs.values():
-            if run.vehicle.kind != "topside":
-                run.portal = PortalRecorder(run.record, self.clock, run.vehicle.name, run.vehicle.ipc_base(self.settings))
-                if self.hosts is not None:
-                    use_interprocess(run.portal, self.hosts.interprocess(run.vehicle, self.settings))
-                run.portal.start()
 
     def wait_for_brokers(self, timeout_s: float = 120.0) -> None:
         """Block until every recorded vehicle's broker has its manager socket (portal clients time out otherwise)."""
@@ -298,14 +288,14 @@ class TrailMission:
 
     # -- watch -------------------------------------------------------------------------------------------------
 
-    def poll_moos(self) -> None:
+    def poll_logs(self) -> None:
+        """Read what every platform's loggers appended since the last poll."""
         for run in self.runs.values():
-            if run.moos is not None:
-                run.moos.poll()
+            run.logs.poll()
 
     def poll(self) -> None:
-        """File new MOOS mail, run the hooks, and check that every launcher is alive (raises ProcessDiedError)."""
-        self.poll_moos()
+        """Read the logs, run the hooks, and check that every launcher is alive (raises ProcessDiedError)."""
+        self.poll_logs()
         for hook in self._hooks:
             hook()
         assert self.group is not None
@@ -316,9 +306,6 @@ class TrailMission:
             self.deaths.append((self.now(), died.name, died.log_tail(40)))
             self.report(f"{died.name} died (exit status {died.returncode}); the other platforms keep running")
             died = self.group.check()
-        for run in self.runs.values():
-            if run.portal is not None and run.portal.error is not None:
-                raise LaunchError(f"the portal recorder of {run.vehicle.name} failed: {run.portal.error}")
 
     def now(self) -> float:
         return self.clock.now()
@@ -372,31 +359,40 @@ class TrailMission:
     # -- stop --------------------------------------------------------------------------------------------------
 
     def stop(self, failure: str | None = None) -> TrailResult:
-        """Stop the recorders, then the launch lines (each inner launcher stops its own processes first)."""
+        """Stop the launch lines (each inner launcher stops its own processes first), then read every platform's
+        logs whole: the result's records are those (t=0 when the last vehicle reached COMMAND)."""
         if self._result is not None:
             return self._result
+        end = self.now()  # the run ends here: the logs go on while the processes stop
         for run in self.runs.values():
-            if run.moos is not None:
-                run.moos.poll()
-                run.moos.close()
-            if run.portal is not None:
-                run.portal.close()
+            run.logs.close()
         ended: list[ProcessOutcome] = []
         if self.group is not None:
             self.group.stop()
             ended = outcomes(self.group.processes)
         logs = sorted(self.log_dir.rglob("*.log")) if self.log_dir.is_dir() else []
         errors = scan_log_files((str(p.relative_to(self.log_dir)), p) for p in logs)
-        t0 = self.t0 if self.t0 is not None else 0.0
+        records: dict[str, MissionRecord] = {}
+        paths: dict[str, list[Path]] = {}
+        for name, run in self.runs.items():
+            read = read_platform(run.vehicle.log_dir(self.settings), name, self.settings.warp,
+                                 moos=run.vehicle.kind != "topside", moos_variables=self.moos_variables,
+                                 node_status=run.vehicle.kind == "topside", origin=self.clock.origin)
+            records[name] = until(read.record, end)
+            paths[name] = [p for p in (read.goby_path, read.alog_path) if p is not None]
+        command_times = {name: command_time(record) for name, record in records.items()}
+        under_command = [t for name, t in command_times.items() if t is not None and name != "topside"]
+        t0 = max(under_command) if under_command else (self.t0 if self.t0 is not None else 0.0)
         self._result = TrailResult(
-            records={name: shifted(run.record, t0) for name, run in self.runs.items()},
-            command_times={name: (None if run.command_time() is None else run.command_time() - t0)  # type: ignore[operator]
-                           for name, run in self.runs.items()},
+            records={name: shifted(record, t0) for name, record in records.items()},
+            command_times={name: None if t is None else t - t0 for name, t in command_times.items()},
             t0=t0,
             outcomes=ended,
             log_errors=errors,
             failure=failure,
             deaths=[(t - t0, name, tail) for t, name, tail in self.deaths],
+            logs=paths,
+            origin=self.clock.origin,
         )
         return self._result
 
@@ -419,9 +415,9 @@ def log_path(mission: TrailMission, platform: str, program: str) -> Path:
 
 
 
-def _ports_free(ports: Sequence[int]) -> bool:
+def _ports_free(ports: Sequence[int], kind: socket.SocketKind = socket.SOCK_STREAM) -> bool:
     for port in ports:
-        with socket.socket() as sock:
+        with socket.socket(socket.AF_INET, kind) as sock:
             try:
                 sock.bind(("127.0.0.1", port))
             except OSError:
@@ -430,10 +426,12 @@ def _ports_free(ports: Sequence[int]) -> bool:
 
 
 def with_free_ports(settings: TrailSettings, n_auvs: int, prefer_course: bool = True) -> TrailSettings:
-    """The settings with MOOS/simulator/liaison port bases and link ports whose every port is free now.
+    """The settings with MOOS/simulator/liaison port bases and link ports whose every port is free now, and a free
+    AIS port and moos-share port base.
 
     The course's values first (when ``prefer_course``), else random ones, so side-by-side runs and tests do not
-    collide with a mission someone else is running.
+    collide with a mission someone else is running. The AIS and moos-share ports are chosen on their own (the
+    course's 54000 and 9300 first), so a busy AIS port does not move the MOOS ports.
     """
     ids = range(n_auvs + 2)
     options = [(9000, 55000, 50000, 54500)] if prefer_course else []
@@ -444,7 +442,13 @@ def with_free_ports(settings: TrailSettings, n_auvs: int, prefer_course: bool = 
         options.append((base, base + 5000, base + 10000, base + 15000))
     for moos, sim, liaison, link in options:
         ports = [*(moos + i for i in ids), *(sim + i for i in ids), *(liaison + i for i in ids), link, link + 1]
-        if _ports_free(ports):
+        if not _ports_free(ports):
+            continue
+        ais = next((p for p in [*([54000] if prefer_course else []), *range(liaison + 300, liaison + 400)]
+                    if _ports_free([p])), None)
+        share = next((b for b in [*([9300] if prefer_course else []), *range(moos + 300, moos + 400, 10)]
+                      if _ports_free([b + i for i in ids], socket.SOCK_DGRAM)), None)
+        if ais is not None and share is not None:
             return settings.replace(moos_port_base=moos, sim_port_base=sim, liaison_port_base=liaison,
-                                    satellite_port=link, acomms_port=link + 1)
+                                    satellite_port=link, acomms_port=link + 1, share_port_base=share, ais_port=ais)
     raise LaunchError("no free port range for the mission's MOOSDBs, simulators and pages")

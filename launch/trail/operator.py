@@ -21,8 +21,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from frontseat import groups as frontseat_groups
-from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
 from gateway.goby.intervehicle import Publisher
 from gateway.goby.portal import SimpleThread
 from gateway.moos_gateway.protobuf.moos_gateway_config_pb2 import GobyMOOSGatewayConfig
@@ -108,15 +106,6 @@ class PortalWorker(BackgroundPortalThread):
 
     def submit(self, job: Callable[[SimpleThread], None]) -> None:
         self._jobs.put(job)
-
-    def watch_node_status(self, record: MissionRecord, clock: SimClock) -> None:
-        """File every NodeStatus on this platform's interprocess (the topside manager's output) by vehicle name."""
-
-        def on_status(status: NodeStatus) -> None:
-            record.add_event(clock.now(), self._cfg.interprocess.platform, "node_status", status.name,
-                             f"{status.local_fix.x:.0f},{status.local_fix.y:.0f}")
-
-        self.submit(lambda thread: thread.interprocess().subscribe(frontseat_groups.node_status, NodeStatus, on_status))
 
 
 class Operator:

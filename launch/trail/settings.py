@@ -59,7 +59,7 @@ _ENV = env_variables("TRAIL_", (
     "satellite_port", "acomms_port", "moosdb", "helm", "usv_helm", "liaison_address", "link_address", "schedule",
     "socket_dir",
     "east_duration", "south_duration", "acomms_channel", "satellite_channel", "moos_address", "broker_address",
-    "broker_port", "link_peers"))
+    "broker_port", "link_peers", "ais_address", "ais_port", "share_port_base", "usv_address"))
 CHANNEL_LINKS = ("satellite", "acomms")
 
 
@@ -101,6 +101,14 @@ class TrailSettings(EnvSettings):
     # ... and the sources the links accept (our udp_peers extension): comma-separated addresses or networks of
     # the peers' computers ("": any on a host address, loopback only on 127.0.0.1)
     link_peers: str = ""
+    # The topside's goby-opencpn-interface: AIS sentences for OpenCPN on this TCP address and port (the course's
+    # 54000; loopback unless asked, docs/opencpn.md)
+    ais_address: str = "127.0.0.1"
+    ais_port: int = 54000
+    # moos-share (pShare's role): each vehicle's input port is share_port_base + its vehicle id; the AUVs send
+    # NODE_REPORT_LOCAL as NODE_REPORT to the USV's, on usv_address (the USV's host; loopback on one machine)
+    share_port_base: int = 9300
+    usv_address: str = "127.0.0.1"
 
     def __post_init__(self) -> None:
         check_warp_and_origin(self.warp, self.lat_origin, self.lon_origin)
@@ -108,15 +116,18 @@ class TrailSettings(EnvSettings):
             self.channel_model(link)  # a bad one is a MissionConfigError naming the variable and the field
         if self.usv_helm not in ("ivp", "goby"):
             raise MissionConfigError(f"TRAIL_USV_HELM must be ivp or goby, not {self.usv_helm!r}")
-        for name in ("link_address", "moos_address", *(("broker_address",) if self.broker_address else ())):
+        for name in ("link_address", "moos_address", "ais_address", "usv_address",
+                     *(("broker_address",) if self.broker_address else ())):
             try:
                 ipaddress.IPv4Address(getattr(self, name))
             except ValueError:
                 raise MissionConfigError(f"{_ENV[name]} must be an IPv4 address, not {getattr(self, name)!r}") from None
         self.peer_networks()
-        if not 0 < self.broker_port < 65536:
-            raise MissionConfigError(f"TRAIL_BROKER_PORT {self.broker_port} is not a TCP port")
-        for name in ("moos_port_base", "sim_port_base", "liaison_port_base", "satellite_port", "acomms_port"):
+        for name in ("broker_port", "ais_port"):
+            if not 0 < getattr(self, name) < 65536:
+                raise MissionConfigError(f"{_ENV[name]} {getattr(self, name)} is not a TCP port")
+        for name in ("moos_port_base", "sim_port_base", "liaison_port_base", "satellite_port", "acomms_port",
+                     "share_port_base"):
             port = getattr(self, name)
             if not 0 < port < 65536 - 256:
                 raise MissionConfigError(f"{name} {port} is not a TCP/UDP port with room for 256 vehicles")
@@ -211,6 +222,10 @@ class Vehicle:
 
     def moos_port(self, settings: TrailSettings) -> int:
         return settings.moos_port_base + self.vehicle_id
+
+    def share_port(self, settings: TrailSettings) -> int:
+        """Where this vehicle's moos-share listens (only the USV's does: the AUVs' NODE_REPORTs)."""
+        return settings.share_port_base + self.vehicle_id
 
     def sim_port(self, settings: TrailSettings) -> int:
         return settings.sim_port_base + self.vehicle_id

@@ -85,16 +85,20 @@ def _latest(record: MissionRecord, name: str, source: str = "moos") -> str:
 
 
 def progress_line(records: dict[str, MissionRecord], elapsed: float, duration: float | None) -> str:
-    """One line while the mission runs: sim time, then per vehicle its interface state, position and depth."""
+    """One line while the mission runs: sim time, then per vehicle its state (the interface's until the helm has
+    command, then DEPLOY_STATE / AUV_DEPLOY_STATE), position and depth."""
     parts = []
     for name, record in records.items():
         if name == "topside":
             continue
         nav = record.snapshot()[0]
         state = _latest(record, "interface_state", "interface")
+        deploy = _latest(record, "DEPLOY_STATE" if name == "usv" else "AUV_DEPLOY_STATE")
+        if state == "COMMAND" and deploy != "?":
+            state = deploy  # under helm command the mission's state is the news (RECOVER), not the interface's
         where = f"({nav[-1].x:.0f},{nav[-1].y:.0f})" if nav else "(no nav)"
         depth = f" {nav[-1].depth:.0f}m" if nav and nav[-1].depth else ""
-        parts.append(f"{name} {state[:4]} {where}{depth}")
+        parts.append(f"{name} {state} {where}{depth}")
     total = f"/{duration:.0f}" if duration else ""
     return f"t={elapsed:6.0f}{total} s | " + " | ".join(parts)
 

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from launch.config import SHARED_TEMPLATES, config_main, find_generator, make_dirs, render, text_format_string
 from launch.errors import MissionConfigError
+from launch.record import load_shared_library_lines
 from launch.usv.analysis import bhv_loiter_polygon, bhv_waypoints
 from launch.usv.settings import USV_DIR, UsvSettings
 from translators.usv.satellite import TOPSIDE_MODEM_ID, USV_MODEM_ID
@@ -84,6 +85,23 @@ def _vehicle_interprocess(settings: UsvSettings) -> str:
                     .replace("interprocess {", "").replace("}", "").split())
 
 
+def _goby_logger(topside: bool) -> Callable[[UsvSettings], str]:
+    """goby-logger on the USV's broker (or the topside's): ``<run_dir>/logs/<platform>/<platform>_<time>.goby``."""
+
+    def generate(settings: UsvSettings) -> str:
+        values = _topside_values(settings, "goby-logger") if topside else _values(settings, "goby-logger")
+        values["data_log_dir"] = data_log_dir(settings, str(values["platform"]))
+        values["load_shared_library"] = load_shared_library_lines()
+        return render(SHARED_TEMPLATES / "goby_logger.pb.cfg.in", values)
+
+    return generate
+
+
+def data_log_dir(settings: UsvSettings, platform: str) -> Path:
+    """Where a platform's goby-logger and moos-logger write: ``<run_dir>/logs/<platform>``."""
+    return settings.log_dir / platform
+
+
 def _topside_manager(settings: UsvSettings) -> str:
     """topside-manager on the topside's broker: the USV's nav and health from its satellite modem."""
     values = _topside_values(settings, "topside-manager")
@@ -112,12 +130,15 @@ def _liaison_web(settings: UsvSettings) -> str:
     if polygon is not None:
         points += "\n    " + "\n    ".join(f"loiter_polygon {{ x: {x:.1f} y: {y:.1f} }}" for x, y in polygon.vertices)
     values["map_points"] = points
+    values["replay_dir"] = text_format_string(str(settings.run_dir / "logs"))  # the map replays this run's logs
     return render(TEMPLATES / "liaison_web.pb.cfg.in", values)
 
 
 def moos_file_text(settings: UsvSettings) -> str:
     """The .moos mission file's text (globals shared with the Goby side, the helm's ProcessConfig)."""
-    return render(TEMPLATES / "usv.moos.in", _values(settings, "moos"))
+    values = _values(settings, "moos")
+    values["data_log_dir"] = data_log_dir(settings, settings.platform)
+    return render(TEMPLATES / "usv.moos.in", values)
 
 
 def write_moos_file(settings: UsvSettings) -> Path:
@@ -148,6 +169,8 @@ GENERATORS: dict[str, Callable[[UsvSettings], str]] = {
     "usv_manager": _pb("usv_manager.pb.cfg.in", "usv-manager"),
     "goby_coroner": _pb("goby_coroner.pb.cfg.in", "goby-coroner"),
     "usv_health_monitor": _pb("usv_health_monitor.pb.cfg.in", "usv-health-monitor"),
+    "goby_logger": _goby_logger(topside=False),
+    "topside_goby_logger": _goby_logger(topside=True),
     "topside_manager": _topside_manager,
     "topside_broker": _topside("broker.pb.cfg.in", "goby-broker"),
     "shore": _topside("shore.pb.cfg.in", "usv-shore"),
@@ -164,7 +187,8 @@ def generate(app: str, settings: UsvSettings) -> str:
     """One app's configuration text; MissionConfigError for an unknown app or a bad setting."""
     generator = find_generator(GENERATORS, app)
     # The run directory holds the broker's sockets and the .moos file: make sure it exists whichever app comes first.
-    make_dirs(settings.run_dir, Path(settings.ipc_base).parent, Path(settings.topside_ipc_base).parent)
+    make_dirs(settings.run_dir, Path(settings.ipc_base).parent, Path(settings.topside_ipc_base).parent,
+              data_log_dir(settings, settings.platform), data_log_dir(settings, settings.topside_platform))
     return generator(settings)
 
 

@@ -2,9 +2,10 @@
 
 Starts every process of ``launch/usv/usv.launch`` with generated configs, lets the shore script command
 the vehicle (loiter on a hexagon, then the waypoints, then an octagon of radius 400; ``--schedule none``: no
-commands, the user sends them with the printed ``usv-command`` lines), records the track
-through a MOOS client and a portal subscriber, then writes ``track.csv``, ``events.csv`` and ``track.png``
-into the output directory and prints a summary. Exit status 0 only if the mission ran and every process
+commands, the user sends them with the printed ``usv-command`` lines); goby-logger and moos-logger log every
+platform (``<out>/run/logs/usv``, ``<out>/run/logs/topside``). After the run the track and events are read from
+those logs, ``track.csv``, ``events.csv`` and ``track.png`` are written into the output directory and a summary is
+printed, with where the logs are and the command that turns them into MCAP for Foxglove. Exit status 0 only if the mission ran and every process
 stopped cleanly.
 """
 
@@ -21,10 +22,18 @@ import time
 from pathlib import Path
 
 from gateway.goby.acomms.udp_multicast import random_multicast
-from launch.demo import add_run_arguments, demo_main, fresh_run_dir, run_mission, schedule_type, whole_number
+from launch.demo import (
+    add_run_arguments,
+    demo_main,
+    fresh_run_dir,
+    plotting,
+    run_mission,
+    schedule_type,
+    whole_number,
+)
+from launch.recorder import logs_lines
 from launch.usv.analysis import bhv_waypoints, command_effects, loiter_phases, transitions
 from launch.usv.mission import MissionResult, UsvMission, choose_program, liaison_page_urls
-from launch.usv.plot import write_track_png
 from launch.usv.settings import DEFAULT_SCHEDULE, KAUAI_ORIGIN, UsvSettings
 from launch.usv.shore import SCHEDULE_HELP, parse_schedule
 from launch.usv.summary import progress_line, summary_text
@@ -33,6 +42,7 @@ from util.logsetup import add_verbosity_argument
 from util.process import free_port
 
 log = logging.getLogger(__name__)
+PLOT = "launch.usv.plot"  # matplotlib: the [demo] extra, imported by plotting() when a run draws
 
 DEFAULT_DURATION_S = 1400.0
 DEFAULT_WARP = 20
@@ -161,12 +171,13 @@ def write_outputs(result: MissionResult, settings: UsvSettings, out: Path) -> tu
     deploy = transitions(record.events_named("DEPLOY_STATE", source="moos"))
     title = (f"USV mission: {settings.helm} + {settings.moosdb}, warp {settings.warp}, "
              f"{len(command_effects(record))} commands from shore")
-    write_track_png(png, record.snapshot()[0], deploy, loiter_phases(record), bhv_waypoints(settings.bhv_file),
+    plotting(PLOT, "track.png").write_track_png(png, record.snapshot()[0], deploy, loiter_phases(record), bhv_waypoints(settings.bhv_file),
                     command_effects(record), title)
     return track_csv, png
 
 
 def run_demo(args: argparse.Namespace) -> int:
+    plotting(PLOT, "track.png")  # before any process starts
     out: Path = args.out.resolve()
     run_dir, socket_dir = fresh_run_dir(out, "usv-", MAX_SOCKET_BASE)
     settings = make_settings(args, run_dir, socket_dir)
@@ -202,6 +213,7 @@ def run_demo(args: argparse.Namespace) -> int:
     track_csv, png = write_outputs(result, settings, out)
     print(summary_text(result, bhv_waypoints(settings.bhv_file)), flush=True)
     print(f"wrote {track_csv}, {out / 'events.csv'} and {png} ({time.monotonic() - started:.0f} s real time)")
+    print("\n".join(logs_lines(settings.log_dir, result.logs)), flush=True)
     clean = all(o.clean for o in result.outcomes)
     return 0 if failure is None and clean else 1
 

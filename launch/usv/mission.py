@@ -1,4 +1,4 @@
-"""Run the USV mission from Python: launch usv.launch's processes, record them, stop them, check the logs.
+"""Run the USV mission from Python: launch usv.launch's processes (their loggers among them), stop them, read the logs.
 
 Used by the demo (``launch.usv.demo``) and the end-to-end test, so both run exactly what a user's
 ``goby-launch launch/usv/usv.launch`` runs, with the same generated configs.
@@ -14,14 +14,14 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from gateway.goby.portal.endpoints import ipc_manager_path
 from launch.errors import LaunchError, ProcessDiedError
 from launch.launchfile import parse_file
 from launch.liaison.portal_side import READY_PREFIX as LIAISON_READY
 from launch.mission import ProcessOutcome, choose_program, outcomes, scan_logs
 from launch.process_group import ProcessGroup, child_environment
-from launch.record import MissionRecord, shifted
-from launch.recorder import MoosRecorder, PortalRecorder, SimClock
+from launch.record import MissionRecord, shifted, until
+from launch.recorder import PlatformLogs, SimClock, read_platform
+from launch.usv.config import data_log_dir
 from launch.usv.settings import USV_DIR, UsvSettings
 
 log = logging.getLogger(__name__)
@@ -32,13 +32,30 @@ __all__ = ["LAUNCH_FILE", "MissionResult", "UsvMission", "choose_program"]
 
 @dataclass
 class MissionResult:
-    """Everything the demo prints and the test asserts: the record (t=0 at COMMAND) and the shutdown."""
+    """Everything the demo prints and the test asserts: the record read from the logs (t=0 at COMMAND), the
+    shutdown, and the logs it was read from."""
 
     record: MissionRecord
     command_time: float | None
     outcomes: list[ProcessOutcome] = field(default_factory=list)
     log_errors: list[str] = field(default_factory=list)
     failure: str | None = None
+    logs: list[Path] = field(default_factory=list)  # the .goby and .alog files the record was read from
+
+
+def read_mission_logs(settings: UsvSettings, origin: float = 0.0) -> tuple[MissionRecord, list[Path]]:
+    """The USV mission's record from its logs after the run: the USV's .goby and .alog (track, helm, commands,
+    interface state, command acks) and the topside's .goby (the satellite link's acks); sim seconds after
+    ``origin`` (see ``launch.recorder``), unshifted."""
+    record = MissionRecord()
+    paths: list[Path] = []
+    for platform, moos in ((settings.platform, True), (settings.topside_platform, False)):
+        logs = read_platform(data_log_dir(settings, platform), platform, settings.warp, moos=moos, origin=origin)
+        paths += [p for p in (logs.goby_path, logs.alog_path) if p is not None]
+        record.nav += logs.record.nav
+        record.events += logs.record.events
+    record.sort()
+    return record, paths
 
 
 def liaison_page_urls(base: str) -> dict[str, str]:
@@ -62,19 +79,18 @@ class UsvMission:
         self.launch_file = launch_file
         self.report = report
         self.launch_delay_s = launch_delay_s
-        self.record = MissionRecord()
+        self.record = MissionRecord()  # the live view, read from the logs as they grow
         self.clock = SimClock(settings.warp)
         self.group: ProcessGroup | None = None
-        self.moos: MoosRecorder | None = None
-        self.portal: PortalRecorder | None = None
-        self.topside: PortalRecorder | None = None
+        self.live = [PlatformLogs(directory, platform, settings.warp, self.record, moos=platform == settings.platform,
+                                  origin=self.clock.origin) for platform, directory in self.log_dirs().items()]
         self.command_time: float | None = None
         # Set from any thread or a signal handler to end start-up, the wait for COMMAND, or the run.
         self.stop_event = threading.Event()
         self._stopped_result: MissionResult | None = None
 
     def start(self) -> None:
-        """Start every process of the launch file, then the recorders."""
+        """Start every process of the launch file (goby-logger and moos-logger among them)."""
         self.settings.run_dir.mkdir(parents=True, exist_ok=True)
         env = child_environment() | self.settings.to_env()
         self.group = ProcessGroup(
@@ -88,53 +104,19 @@ class UsvMission:
             report=self.report,
         )
         self.group.stop_event = self.stop_event
-        # The MOOS client retries until the MOOSDB is up, so it sees everything from the first posting; its mail
-        # is read while the launch waits between processes, so start-up events get their real times.
-        self.moos = MoosRecorder(self.record, self.clock, self.settings.moos_port)
-        self.moos.start()
-        self.group.on_wait = self._record_start_up
+        # the logs are read while the launch waits between processes, so the live view starts with the run
+        self.group.on_wait = self.poll_logs
         self.group.start()
-        self._wait_for_brokers()
 
-    def _record_start_up(self) -> None:
-        """While the launch waits between processes: read MOOS mail, and start each portal recorder as soon as its
-        broker is up, so it listens before the shore (launched after both brokers) can send anything."""
-        assert self.moos is not None
-        self.moos.poll()
-        self._start_portal_recorders()
+    def log_dirs(self) -> dict[str, Path]:
+        """Where each platform's goby-logger (and the USV's moos-logger) write."""
+        return {platform: data_log_dir(self.settings, platform)
+                for platform in (self.settings.platform, self.settings.topside_platform)}
 
-    def _start_portal_recorders(self) -> list[str]:
-        """The USV broker's recorder (interface state) and the topside's (the satellite link's acks), each once its
-        broker is up; returns the manager sockets still missing."""
-        if self.portal is None:
-            self.portal = self._recorder_if_up(self.settings.platform, self.settings.ipc_base)
-        if self.topside is None:
-            self.topside = self._recorder_if_up(self.settings.topside_platform, self.settings.topside_ipc_base)
-        return [ipc_manager_path(base) for recorder, base in ((self.portal, self.settings.ipc_base),
-                                                              (self.topside, self.settings.topside_ipc_base))
-                if recorder is None]
-
-    def _recorder_if_up(self, platform: str, ipc_base: str) -> PortalRecorder | None:
-        """A started recorder on the broker at ``ipc_base``, or None while its manager socket does not exist."""
-        if not Path(ipc_manager_path(ipc_base)).exists():
-            return None
-        recorder = PortalRecorder(self.record, self.clock, platform, ipc_base)
-        recorder.start()
-        return recorder
-
-    def _wait_for_brokers(self, timeout_s: float = 120.0) -> None:
-        """Block until both portal recorders have started, i.e. both brokers (the USV's, the topside's) have their
-        manager socket: the topside's is launched late, and a portal client gives up if its broker does not
-        answer."""
-        deadline = time.monotonic() + timeout_s
-        while missing := self._start_portal_recorders():
-            if self.stop_event.is_set():
-                return
-            self._check()
-            if time.monotonic() > deadline:
-                raise LaunchError(f"no broker at {', '.join(missing)} within {timeout_s:g} s "
-                                  f"(logs in {self.settings.log_dir})")
-            time.sleep(0.1)
+    def poll_logs(self) -> None:
+        """Read what the loggers appended since the last poll into the live record."""
+        for logs in self.live:
+            logs.poll()
 
     def liaison_urls(self, timeout_s: float = 30.0, process_name: str = "goby-liaison") -> dict[str, str]:
         """The URLs a goby-liaison serves (home, scope, commander, map), read from its ready line in its log:
@@ -163,14 +145,10 @@ class UsvMission:
         died = self.group.check()
         if died is not None:
             raise ProcessDiedError(died.name, died.returncode, died.log_tail())
-        for recorder in (self.portal, self.topside):
-            if recorder is not None and recorder.error is not None:
-                raise LaunchError(f"the demo's portal recorder failed: {recorder.error}")
 
     def poll(self) -> None:
-        """File new MOOS mail and check that every process is alive (raises ProcessDiedError)."""
-        if self.moos is not None:
-            self.moos.poll()
+        """Read what the loggers appended and check that every process is alive (raises ProcessDiedError)."""
+        self.poll_logs()
         self._check()
         if self.command_time is None:
             states = self.record.events_named("interface_state", source="interface")
@@ -218,23 +196,23 @@ class UsvMission:
             time.sleep(0.05)
 
     def stop(self, failure: str | None = None) -> MissionResult:
-        """Stop the recorders, then the processes (reverse order); check exit statuses and logs."""
+        """Stop the processes (reverse order), check exit statuses and logs, then read the mission's logs."""
         if self._stopped_result is not None:
             return self._stopped_result
-        if self.moos is not None:
-            self.moos.poll()
-            self.moos.close()
-        for recorder in (self.portal, self.topside):
-            if recorder is not None:
-                recorder.close()
+        end = self.clock.now()  # the run ends here: the logs go on while the processes stop
+        for logs in self.live:
+            logs.close()
         ended: list[ProcessOutcome] = []
         errors: list[str] = []
         if self.group is not None:
             self.group.stop()
             ended = outcomes(self.group.processes)
             errors = scan_logs(self.group.processes)
-        t0 = self.command_time or 0.0
-        self._stopped_result = MissionResult(shifted(self.record, t0), self.command_time, ended, errors, failure)
+        record, paths = read_mission_logs(self.settings, self.clock.origin)
+        record = until(record, end)
+        states = record.events_named("interface_state", source="interface")
+        command = next((e.t for e in states if e.value == "INTERFACE_COMMAND"), None)
+        self._stopped_result = MissionResult(shifted(record, command or 0.0), command, ended, errors, failure, paths)
         return self._stopped_result
 
     def __enter__(self) -> UsvMission:

@@ -1,4 +1,4 @@
-"""Trail analyses on hand-made records: relative geometry, trail errors, commands and their latency, RECOVER,
+"""Trail analyses on hand-made records (and on hand-made logger files read back): relative geometry, trail errors, commands and their latency, RECOVER,
 link counting from real ModemTransmission datagrams, the schedule and the picture."""
 
 from __future__ import annotations
@@ -6,10 +6,16 @@ from __future__ import annotations
 import math
 
 import pytest
+from google.protobuf import text_format
 
+from frontseat.protobuf.frontseat_data_pb2 import NodeStatus
 from gateway.goby.acomms.protobuf.modem_message_pb2 import ModemTransmission
+from gateway.goby.log import LogWriter
+from gateway.goby.portal import Scheme
+from gateway.moos.alog import AlogWriter
 from launch.errors import MissionConfigError
 from launch.record import MissionRecord, NavSample
+from launch.recorder import read_platform
 from launch.trail.analysis import (
     angle_difference,
     command_outcomes,
@@ -122,3 +128,48 @@ def test_picture_is_written(tmp_path):
     path = tmp_path / "trail.png"
     write_trail_png(path, {"usv": usv, "auv0": auv}, [], [recover_outcome("auv0", auv)], [perf], "test")
     assert path.stat().st_size > 10_000
+
+
+def test_trail_errors_and_topside_view_from_the_loggers_files(tmp_path):
+    """The same judgement from the files the loggers write: the USV's and the AUV's alogs (moos-logger, MOOS times
+    = Unix time x warp), the topside's .goby with the NodeStatus it republishes (goby-logger, real time)."""
+    warp, logstart = 10, 1_795_000_000.0 * 10
+    usv, auv = MissionRecord(), MissionRecord()
+    _usv_east(usv)
+    for t in range(300):
+        off = 100.0 if t < 50 else 55.0
+        auv.add_nav(float(t), "NAV_DEPTH", 10.0 if t >= 50 else 2.0)
+        auv.add_nav(float(t), "NAV_X", 1.5 * t)
+        auv.add_nav(float(t), "NAV_Y", -off)
+    for name, record, depth in (("usv", usv, False), ("auv0", auv, True)):
+        session = tmp_path / name / f"{name.upper()}_1_1_2027_____00_00_00"
+        session.mkdir(parents=True)
+        with AlogWriter(session / f"{session.name}.alog", logstart) as alog:
+            for s in record.nav:
+                for i, (var, value) in enumerate((("NAV_X", s.x), ("NAV_Y", s.y), ("NAV_HEADING", s.heading),
+                                                  ("NAV_DEPTH", s.depth if depth else None))):
+                    if value is not None:
+                        alog.write(logstart + s.t + 0.002 * i, var, "goby::moos::Translator", value)
+            if depth:
+                alog.write(logstart + 250.0, "DEPLOY_DEPTH_UPDATES", "goby::moos::Translator", "depth=0")
+                alog.write(logstart + 250.0, "AUV_DEPLOY_STATE", "goby::moos::Translator", "RECOVER")
+    (tmp_path / "topside").mkdir()
+    with open(tmp_path / "topside" / "topside_20270101T000000.goby", "wb") as f:
+        writer = LogWriter(f.write, lambda: 0)
+        for t in range(0, 300, 10):
+            for name in ("USV", "AUV_0"):
+                status = text_format.Parse(f'time: {t} name: "{name}" global_fix {{ lat: 0 lon: 0 }} pose {{ }} '
+                                           f'local_fix {{ x: {1.5 * t} y: 0 }} speed {{ over_ground: 1.5 }}', NodeStatus())
+                writer.write(status.SerializeToString(), Scheme.PROTOBUF, status.DESCRIPTOR.full_name,
+                             "goby::middleware::frontseat::node_status", round((logstart + t) / warp * 1e6))
+    read = {name: read_platform(tmp_path / name, name, warp, origin=logstart).record for name in ("usv", "auv0")}
+    topside = read_platform(tmp_path / "topside", "topside", warp, moos=False, node_status=True, origin=logstart)
+    assert [(e.t, e.value, e.origin) for e in topside.record.events[:2]] == [(0.0, "USV", "0,0"), (0.0, "AUV_0", "0,0")]
+    assert len(topside.record.events_named("node_status", "topside")) == 60
+    assert len(read["auv0"].nav) == 300 and len(read["usv"].nav) == 300  # one fix per NAV_* batch
+    perf = trail_performance(Vehicle("auv", 2, 0), read["auv0"], read["usv"])
+    assert perf.settled_at == pytest.approx(50, abs=0.01)
+    assert perf.range_error.mean == pytest.approx(5, abs=0.01) and perf.depth_error.max == pytest.approx(0)
+    assert perf.end == pytest.approx(250, abs=0.01)
+    outcome = recover_outcome("auv0", read["auv0"])
+    assert outcome.commanded_at == pytest.approx(250, abs=0.01) and outcome.depth_updates_first

@@ -7,7 +7,8 @@ the acoustic link. Asserted from the recorded run, the course_and_peers §1.10 c
 every vehicle reaches COMMAND; the topside republishes every vehicle's nav as NodeStatus; the USV obeys both
 commands (POLYGON_UPDATES before DEPLOY_STATE) and every command is acked; the AUVs trail at their angle and depth;
 RECOVER reaches every AUV (depth=0 first), which surfaces and heads for the station; every process exits cleanly
-with no error line in any log.
+with no error line in any log. The vehicles' records are read from the run's logs (a .goby per platform, an .alog
+per MOOS community), and those logs export to MCAP with every platform's groups.
 """
 
 from __future__ import annotations
@@ -17,12 +18,14 @@ import shutil
 import pytest
 
 from launch.process_group import child_environment
-from launch.record import MissionRecord, shifted
+from launch.record import MissionRecord, shifted, until
+from launch.recorder import read_platform
 from launch.trail.analysis import command_outcomes, recover_outcome, trail_performance
 from launch.trail.links import LinkMonitor
 from launch.trail.mission import TrailMission, with_free_ports
 from launch.trail.operator import Operator, PortalWorker, parse_trail_schedule
 from launch.trail.settings import TrailSettings, Vehicle
+from tests.launch.mission_logs import assert_logs_per_platform, assert_mcap_export_has_every_group
 
 N_AUVS = 2
 WARP = 10
@@ -50,7 +53,6 @@ def test_trail_mission_two_auvs(tmp_path):
         workers = [topside, usv]
         for worker in workers:
             worker.start()
-        topside.watch_node_status(operator_record, mission.clock)
         operator = Operator(parse_trail_schedule(SCHEDULE), operator_record, mission.clock, topside, usv)
         mission.add_hook(operator.poll)
         t0 = mission.wait_for_command(timeout_s=120)
@@ -66,8 +68,26 @@ def test_trail_mission_two_auvs(tmp_path):
     records = result.records
     assert all(t is not None for name, t in result.command_times.items() if name != "topside"), result.command_times
     operator_events = shifted(operator_record, result.t0)
-    seen = {e.value for e in operator_events.events_named("node_status", "topside")}
+    seen = {e.value for e in records["topside"].events_named("node_status", "topside")}
     assert {"USV", "AUV_0", "AUV_1"} <= seen, seen
+
+    # The records are the logs': a .goby per platform, an .alog per MOOS community, in each platform's log
+    # directory; read again, they give the same records; exported to MCAP, every platform's groups.
+    vehicles = {name: run.vehicle for name, run in mission.runs.items()}
+    assert_logs_per_platform(result.logs, {name: v.log_dir(settings) for name, v in vehicles.items()},
+                             {"usv", "auv0", "auv1"})
+    for name, vehicle in vehicles.items():
+        again = read_platform(vehicle.log_dir(settings), name, WARP, moos=vehicle.kind != "topside",
+                              node_status=vehicle.kind == "topside", origin=mission.clock.origin).record
+        last = max([s.t for s in records[name].nav] + [e.t for e in records[name].events]) + result.t0 + 1e-6
+        again = shifted(until(again, last), result.t0)
+        assert again.nav == records[name].nav and again.events == records[name].events, name
+    topics = assert_mcap_export_has_every_group(tmp_path / "logs", [p for paths in result.logs.values()
+                                                                   for p in paths if p.suffix == ".goby"])
+    by_platform = {mcap.name.split("_")[0]: groups for mcap, groups in topics.items()}
+    assert "goby::middleware::frontseat::node_status" in by_platform["topside"], by_platform["topside"]
+    for name in ("usv", "auv0", "auv1"):
+        assert "goby::middleware::frontseat::status" in by_platform[name], by_platform[name]
 
     for i in range(N_AUVS):
         vehicle = Vehicle("auv", N_AUVS, i)

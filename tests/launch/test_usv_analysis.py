@@ -1,4 +1,5 @@
-"""Judging a mission from a hand-made record: polygons, command grouping, loiter phases, the waypoint turn."""
+"""Judging a mission from a hand-made record (and from hand-made logger files read back): polygons, command grouping,
+loiter phases, the waypoint turn."""
 
 from __future__ import annotations
 
@@ -7,19 +8,26 @@ import math
 
 import pytest
 
+from frontseat.protobuf.frontseat_pb2 import InterfaceState, InterfaceStatus
+from gateway.goby.log import LogWriter
+from gateway.goby.portal import Scheme
+from gateway.moos.alog import AlogWriter
 from launch.record import MissionRecord, shifted
 from launch.usv.analysis import (
     bhv_waypoints,
     command_effects,
+    link_acks,
     loiter_phases,
     normalized_heading,
     waypoint_approach,
 )
+from launch.usv.config import data_log_dir
 from launch.usv.geometry import parse_points, parse_polygon, radial_polygon
-from launch.usv.mission import MissionResult
+from launch.usv.mission import MissionResult, read_mission_logs
 from launch.usv.plot import write_track_png
 from launch.usv.settings import UsvSettings
 from launch.usv.summary import progress_line, summary_text
+from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 
 
 def test_radial_polygon_matches_moos_ivp_vertex_order():
@@ -172,3 +180,84 @@ def test_outputs_csv_and_png(tmp_path):
     write_track_png(tmp_path / "track.png", record.nav, [(e.t, e.value) for e in record.events], loiter_phases(record),
                     [(134, 33)], command_effects(record), "test")
     assert (tmp_path / "track.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+# -- the record read from the loggers' files --------------------------------------------------------------------
+
+WARP = 20
+LOGSTART = 1_795_000_000.0 * WARP  # MOOS time (Unix time times the warp) when the alog was opened
+
+
+def _write_logs(settings: UsvSettings) -> None:
+    """What moos-logger and the two goby-loggers would have written for ``_mission_record()``'s mission, 50 s of
+    interface start-up before it: the alog with every fix's NAV_* a millisecond apart (each posting has its own
+    MOOS time) and the helm's repeated postings; the USV's .goby with the interface's states; the topside's with
+    the satellite link's ack."""
+
+    t0 = LOGSTART + 50.0  # the interface reaches COMMAND here: t=0 of the record
+    record = _mission_record()
+    session = data_log_dir(settings, "usv") / "usv_1_1_2027_____00_00_00"
+    session.mkdir(parents=True)
+    rows: list[tuple[float, str, str, float | str]] = []
+    for s in record.nav:
+        for i, (var, value) in enumerate((("NAV_X", s.x), ("NAV_Y", s.y), ("NAV_HEADING", s.heading),
+                                          ("NAV_SPEED", 1.5))):
+            if value is not None:
+                rows.append((t0 + s.t + 0.001 * i, var, "moos-gateway", value))
+    for e in record.events:
+        rows.append((t0 + e.t, e.name, e.origin, e.value))
+    for t in range(0, 600, 10):  # the helm's state, posted every iteration: one change only
+        rows.append((t0 + t + 0.5, "IVPHELM_STATE", "pHelmIvP", "DRIVE"))
+        rows.append((t0 + t + 0.5, "DESIRED_SPEED", "pHelmIvP", 1.5))  # not recorded
+    with AlogWriter(session / "usv_1_1_2027_____00_00_00.alog", LOGSTART) as alog:
+        for when, var, source, value in sorted(rows, key=lambda row: row[0]):
+            alog.write(when, var, source, value)
+
+    def goby(platform: str, entries: list[tuple[float, str, object]]) -> None:
+        out = data_log_dir(settings, platform) / f"{platform}_20270101T000000.goby"
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with open(out, "wb") as f:
+            writer = LogWriter(f.write, lambda: 0)
+            for when, group, message in entries:
+                writer.write(message.SerializeToString(), Scheme.PROTOBUF, message.DESCRIPTOR.full_name, group,
+                             round(when / WARP * 1e6))  # goby-logger runs on real time
+
+    status = "goby::middleware::frontseat::status"
+    goby("usv", [(LOGSTART + t, status, InterfaceStatus(state=state)) for t, state in
+                 ((1, InterfaceState.INTERFACE_STANDBY), (20, InterfaceState.INTERFACE_STANDBY),
+                  (50, InterfaceState.INTERFACE_COMMAND), (60, InterfaceState.INTERFACE_COMMAND))])
+    ack = USVCommandAck(stage=USVCommandAck.LINK_ACKED, responder="satellite modem 2", slot_wait=2.5,
+                        link_latency=3.25)
+    goby("topside", [(t0 + 97.0, "goby3_course::usv_command_ack", ack)])
+
+
+def test_the_record_is_read_from_the_loggers_files(tmp_path):
+    settings = UsvSettings(run_dir=tmp_path / "run", warp=WARP)
+    _write_logs(settings)
+    record, paths = read_mission_logs(settings)
+    assert sorted(p.suffix for p in paths) == [".alog", ".goby", ".goby"]
+    command = next(e.t for e in record.events_named("interface_state") if e.value == "INTERFACE_COMMAND")
+    assert command == pytest.approx(LOGSTART + 50.0, abs=1e-3)
+    record = shifted(record, command)
+    # one state event per change of the interface and the helm
+    assert [(round(e.t), e.value) for e in record.events_named("interface_state")] == [
+        (-49, "INTERFACE_STANDBY"), (0, "INTERFACE_COMMAND")]
+    assert [e.value for e in record.events_named("IVPHELM_STATE")] == ["DRIVE"]
+    assert record.events_named("DESIRED_SPEED") == []
+    # one fix per NAV_* batch, as many as the hand-made record's, at the same places
+    expected = _mission_record()
+    assert len(record.nav) == len(expected.nav)
+    assert [(round(s.x, 2), round(s.y, 2)) for s in record.nav] == [(round(s.x, 2), round(s.y, 2))
+                                                                     for s in expected.nav]
+    assert all(s.speed == 1.5 for s in record.nav)
+    # and the same judgement as from the hand-made record
+    effects = command_effects(record)
+    assert [e.state for e in effects] == ["POLYGON", "WAYPOINTS", "POLYGON"]
+    assert [round(e.t) for e in effects] == [100, 300, 400]
+    first, second = loiter_phases(record)
+    assert (round(first.start), round(first.end)) == (0, 300) and first.mean_distance < 15
+    assert second.ring.center == pytest.approx((134, 33), abs=1)
+    (link,) = link_acks(record)
+    assert (round(link.t), link.acked, link.slot_wait, link.latency) == (97, True, 2.5, 3.25)
+    text = summary_text(MissionResult(record, 0.0), [(134, 33)])
+    assert "over the satellite link (5 s / 64 B slots): t=97 s acked: slot wait 2.5 s, ack after 3.2 s" in text, text

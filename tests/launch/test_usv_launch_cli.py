@@ -59,7 +59,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
         tmp_path / "run.out", env=env,
     ).start()
     try:
-        expect(proc, r"All processes running \(14\)")
+        expect(proc, r"All processes running \(17\)")  # with goby-logger x2, moos-logger
         helm_pid = int(expect(proc, r"^Launched \((\d+)\) usv\.helm:").group(1))
         moosdb_log = tmp_path / "logs" / "usv.moosdb.log"
         # ten Python processes starting at once: the DB may still be importing
@@ -72,7 +72,7 @@ def test_goby_launch_runs_the_usv_launch_file_and_names_a_process_that_dies(tmp_
     assert proc.returncode == 1, text
     assert "usv.helm died unexpectedly (exit status -9)" in text
     pids = [int(pid) for pid, _ in LAUNCHED_LINE.findall(text)]
-    assert len(pids) == 14
+    assert len(pids) == 17
     assert not any(pid_alive(pid) for pid in pids), text
     logs = sorted(p.name for p in (tmp_path / "logs").iterdir())
     assert "usv.frontseat-interface.log" in logs and "usv.shore.log" in logs
@@ -90,7 +90,8 @@ def test_demo_without_a_duration_runs_until_ctrl_c_and_still_writes_its_outputs(
         proc.stop()
     assert proc.returncode == 0, text
     assert "=== USV mission summary" in text
-    assert "processes: 14/14 exited cleanly" in text
+    assert "processes: 17/17 exited cleanly" in text
+    assert "logs of this run" in text and "--format MCAP" in text, text
     assert re.search(r"^topside page \(goby-liaison, commands over the satellite link\): home http://127\.0\.0\.1:\d+/",
                      text, flags=re.M), text
     assert "1. t=" in text and "POLYGON_UPDATES=polygon=radial::x=0,y=0,radius=200,pts=6" in text
@@ -172,7 +173,8 @@ def test_demo_with_no_schedule_prints_a_usv_command_line_that_reaches_this_run(t
     assert re.search(r"^  1\. t=\d+ s: DEPLOY_STATE=WAYPOINTS$", text, flags=re.M), text
     assert "  2. t=" not in text and "acknowledgements: 1 posted to MOOS, 0 refused" in text, text
     assert re.search(r"^waypoints phase t=\d+\.\.\d+ s \(\d+ s, until the end of the run\)", text, flags=re.M), text
-    assert "processes: 14/14 exited cleanly" in text
+    assert "processes: 17/17 exited cleanly" in text
+    assert "logs of this run" in text and "--format MCAP" in text, text
     assert re.search(r"^topside page \(goby-liaison, commands over the satellite link\): home http://127\.0\.0\.1:\d+/",
                      text, flags=re.M), text
     shore_log = (out_dir / "run" / "logs" / "usv.shore.log").read_text()

@@ -1,4 +1,5 @@
-"""The whole USV mission end to end: real processes from launch/usv/usv.launch, commands from shore, the track.
+"""The whole USV mission end to end: real processes from launch/usv/usv.launch, commands from shore, the track
+read from the run's logs (goby-logger's .goby per platform, moos-logger's .alog), which also export to MCAP.
 
 Runs with our moos-db and ivp-helm always, and with the real MOOSDB and pHelmIvP when both are on PATH
 (run the real one inside a private network namespace: the C++ MOOSDB listens on every address).
@@ -19,6 +20,7 @@ from gateway.moos.testing import real_moos_skip_reason
 from launch.interfaces.deployment import DEFAULT_INTERFACES_DIR
 from launch.interfaces.drift import covered_threads, drift_problems
 from launch.interfaces.interface_yaml import load as load_interface
+from launch.record import shifted, until
 from launch.usv.analysis import (
     bhv_waypoints,
     command_effects,
@@ -28,9 +30,11 @@ from launch.usv.analysis import (
     loiter_phases,
     waypoint_approach,
 )
-from launch.usv.mission import MissionResult, UsvMission
+from launch.usv.config import data_log_dir
+from launch.usv.mission import MissionResult, UsvMission, read_mission_logs
 from launch.usv.settings import UsvSettings
 from launch.usv.summary import summary_text
+from tests.launch.mission_logs import assert_logs_per_platform, assert_mcap_export_has_every_group
 from util.process import free_port
 
 WARP = 30
@@ -40,7 +44,8 @@ SCHEDULE = "0:polygon:6:200,450:waypoints,700:polygon:8:400"
 REAL_MOOS_SKIP = real_moos_skip_reason("MOOSDB", "pHelmIvP")
 
 
-def run_mission(run_dir: Path, moosdb: str, helm: str) -> MissionResult:
+def run_mission(run_dir: Path, moosdb: str, helm: str) -> tuple[MissionResult, UsvSettings, float]:
+    """The result, the settings and the mission's time origin (its records' t=0 before the shift to COMMAND)."""
     socket_dir = Path(tempfile.mkdtemp(prefix="usvt-", dir="/tmp"))  # AF_UNIX paths must stay short
     settings = UsvSettings(
         run_dir=run_dir,
@@ -65,7 +70,7 @@ def run_mission(run_dir: Path, moosdb: str, helm: str) -> MissionResult:
     finally:
         result = mission.stop(failure)
         shutil.rmtree(socket_dir, ignore_errors=True)
-    return result
+    return result, settings, mission.clock.origin
 
 
 @pytest.mark.parametrize(
@@ -83,7 +88,7 @@ def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm, monkeypatch):
     registry_dir = tmp_path / "interface_registry"
     registry_dir.mkdir()
     monkeypatch.setenv(REGISTRY_ENV, str(registry_dir))  # every app records the calls it made (see below)
-    result = run_mission(tmp_path / "run", moosdb, helm)
+    result, settings, origin = run_mission(tmp_path / "run", moosdb, helm)
     record = result.record
     waypoints = bhv_waypoints(UsvSettings().bhv_file)
     report = summary_text(result, waypoints)
@@ -134,15 +139,30 @@ def test_vehicle_obeys_commands_from_shore(tmp_path, moosdb, helm, monkeypatch):
     assert octagon.settled_at is not None and octagon.mean_distance is not None, report
     assert octagon.mean_distance < 15.0, report
 
+    # The record is the logs': a .goby per platform (the USV's, the topside's), an .alog for the USV's MOOS
+    # community; read again they give the same record; exported to MCAP (the demo's command), every group.
+    log_dirs = {platform: data_log_dir(settings, platform) for platform in ("usv", "topside")}
+    by_platform = {platform: [p for p in result.logs if log_dirs[platform] in p.parents] for platform in log_dirs}
+    assert_logs_per_platform(by_platform, log_dirs, {"usv"})
+    again, _ = read_mission_logs(settings, origin)
+    last = max([s.t for s in record.nav] + [e.t for e in record.events]) + result.command_time + 1e-6
+    again = shifted(until(again, last), result.command_time)
+    assert again.nav == record.nav and again.events == record.events
+    topics = assert_mcap_export_has_every_group(settings.log_dir, [p for p in result.logs if p.suffix == ".goby"])
+    usv_topics = next(t for mcap, t in topics.items() if mcap.name.startswith("usv_"))
+    assert {"goby::middleware::frontseat::status", "goby3_course::usv_command_ack"} <= usv_topics, usv_topics
+
     # Every process stopped cleanly and no log holds an unexpected error.
-    assert len(result.outcomes) == 14, report  # 11 + goby-coroner, usv-health-monitor, topside-manager
+    # 11 + goby-coroner, usv-health-monitor, topside-manager, the two goby-loggers and moos-logger
+    assert len(result.outcomes) == 17, report
     assert all(o.clean for o in result.outcomes), report
     assert result.log_errors == [], report
 
     # The USV's health reached the topside over the satellite link (goby-coroner -> usv-health-monitor ->
-    # topside-manager; docs/health.md). Only the start-up FAILED reports are seen so far: see docs/health.md.
+    # topside-manager; docs/health.md): GOOD while every expected application answers (topside-manager runs with -v:
+    # a GOOD status is logged at INFO, a FAILED one as a warning).
     manager_log = next(o.log_path for o in result.outcomes if o.name == "topside.manager").read_text()
-    assert "Received HealthStatus: state: " in manager_log, report
+    assert "Received HealthStatus: state: GOOD" in manager_log, report
 
     # What the apps really published and subscribed is what their interface files say (no drift).
     runtime = [entry for path in registry_dir.glob("*.json") for entry in read_entries(path)]
