@@ -4,7 +4,8 @@ Why this shape: goby_moos_gateway ``dlopen``s the libraries listed in the variab
 ``goby3_moos_gateway_load``; we import Python modules instead, through the project's one extension loader
 (``util.extensions``: an entry point of group ``goby_moos_gateway.plugins`` by name, a ``.py`` path, or a dotted
 module).  The list is split on any of ``;``, ``:`` and ``,``, as Goby does.  Goby's library file name
-``libgoby_ivp_frontseat_moos_gateway_plugin.so`` (with or without a directory) stands for our ``frontseat``.
+``libgoby_ivp_frontseat_moos_gateway_plugin.so`` (with or without a directory) stands for our ``frontseat``,
+``libgoby_coroner_moos_gateway_plugin.so`` for our ``coroner``.
 
 Everything is resolved (imported, ``load`` found) before the gateway starts, so a bad entry stops the
 process before anything runs; ``ExtensionError`` names the entry and the cause.
@@ -33,10 +34,12 @@ PLUGIN_POINT = ExtensionPoint(
     source=ENV_VAR,
     # Goby3's shared-library names for the plugins we re-implement (without "lib" and ".so...")
     aliases=MappingProxyType({"goby_ivp_frontseat_moos_gateway_plugin": "frontseat",
+                              "goby_coroner_moos_gateway_plugin": "coroner",
                               "goby3_course_moos_gateway_plugin": "goby3_course"}),
     builtin=MappingProxyType({"frontseat": "translators.frontseat.translation",
                               "usv_command": "translators.usv.command_translation",
                               "node_report": "translators.node_report",
+                              "coroner": "translators.coroner",
                               "goby3_course": "translators.trail.gateway_plugin"}),
 )
 

@@ -1,4 +1,4 @@
-"""The live stack for the translator tests: MOOSDB + broker + moos-gateway (all three of our plugins) + usv-manager.
+"""The live stack for the translator tests: MOOSDB + broker + moos-gateway (our four plugins) + usv-manager.
 
 Module-scoped (set up before the per-test leak check, torn down after a module's last test), and parametrised
 over our moos-db and, inside a private network namespace with /opt/moos/bin on PATH, the real MOOSDB.
@@ -29,7 +29,7 @@ from translators.usv.protobuf.command_ack_pb2 import USVCommandAck
 from translators.usv.protobuf.command_dccl_pb2 import USVCommand
 from util.process import ChildProcess
 
-PLUGINS = "frontseat:usv_command:node_report"
+PLUGINS = "frontseat:usv_command:node_report:libgoby_coroner_moos_gateway_plugin.so"
 STARTUP_TIMEOUT_S = 90.0
 
 

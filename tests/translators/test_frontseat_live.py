@@ -1,7 +1,7 @@
-"""FrontSeatTranslation and NodeReportTranslation in moos-gateway, with a real MOOSDB and broker.
+"""FrontSeatTranslation, NodeReportTranslation and CoronerTranslation in moos-gateway, with a real MOOSDB and broker.
 
 node_status on interprocess -> NAV_* (and NODE_REPORT) in MOOS; DESIRED_* and IVPHELM_STATE posted in MOOS ->
-desired_course and helm_state on interprocess.
+desired_course and helm_state on interprocess; the coroner's VehicleHealth -> GOBY_PROCESS_HEALTH in MOOS.
 """
 
 from __future__ import annotations
@@ -11,10 +11,13 @@ import time
 from collections.abc import Callable
 
 import pytest
+from google.protobuf import text_format
 
 from frontseat import groups
 from frontseat.protobuf.frontseat_data_pb2 import USV, DesiredCourse, NodeStatus
 from frontseat.protobuf.frontseat_pb2 import HELM_DRIVE, HELM_NOT_RUNNING, HELM_PARK, HelmStateReport
+from gateway.goby.portal.health import HEALTH_REPORT
+from gateway.goby.portal.protobuf.coroner_pb2 import HEALTH__FAILED, VehicleHealth
 from gateway.goby.portal.testing import PortalClient, broker_process
 from gateway.moos.testing import connected_comms, running_moosdb
 from translators.frontseat.translation import FrontSeatTranslation
@@ -87,6 +90,24 @@ def test_node_status_becomes_nav_variables_and_a_node_report(stack):
         "usv", "USV", "120", "1.25", "0.5")
     assert float(report["X"]) == pytest.approx(REF_X, abs=0.005)
     assert float(report["Y"]) == pytest.approx(REF_Y, abs=0.005)
+
+
+def test_vehicle_health_reaches_moos_as_goby_process_health(stack):
+    """Goby's coroner gateway plugin (loaded by its library name): the report, in the gateway's technique."""
+    health = VehicleHealth(time=1754431234250000, platform="usv", state=HEALTH__FAILED)
+    process = health.process.add(name="usv-manager", pid=4242)
+    process.main.name = "usv-manager"
+    process.main.state = HEALTH__FAILED
+    got: list[str] = []
+    with connected_comms(stack.moos_port, "watch_health", register=["GOBY_PROCESS_HEALTH"]) as watcher, \
+            PortalClient(stack.broker.interprocess_config(), name="coroner_double") as client:
+        assert client.wait_subscribed()
+        post_until(client, lambda: bool(got.extend(m.string() for m in watcher.fetch()) or got),
+                   lambda: client.publish(HEALTH_REPORT, health), "GOBY_PROCESS_HEALTH", stack.logs)
+    prefix = "@PB[goby.middleware.protobuf.VehicleHealth] "
+    assert got[0].startswith(prefix), got[0]
+    parsed = text_format.Parse(got[0][len(prefix):], VehicleHealth())
+    assert parsed == health
 
 
 def test_desired_setpoints_become_desired_course_with_goby_fallback(stack):
