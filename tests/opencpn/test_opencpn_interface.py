@@ -173,8 +173,9 @@ def test_sentences_decode_to_the_vehicles(broker: BrokerProcess, tmp_path: Path)
         reports = [m for _, m in decoded if m["msg_type"] == 18 and m["mmsi"] == mmsi]
         assert len(reports) >= 5
         for m in reports:
-            nearest = min(abs(m["lat"] - lat) + abs(m["lon"] - lon) for lat, lon in vehicle.published)
-            assert nearest < 1e-5 * 2, (vehicle.name, m)
+            # within 1e-5 degrees in latitude and in longitude of a published NodeStatus (the bound)
+            nearest = min(max(abs(m["lat"] - lat), abs(m["lon"] - lon)) for lat, lon in vehicle.published)
+            assert nearest < 1e-5, (vehicle.name, m)
             assert m["speed"] == pytest.approx(vehicle.speed * KNOTS_PER_MPS, abs=0.051)
             assert m["heading"] == round(vehicle.heading)
         for m in reports[1:]:  # the first report has one status: no course yet
