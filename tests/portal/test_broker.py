@@ -232,7 +232,8 @@ def test_a_goby_style_raw_client_completes_the_hold_handshake(tmp_path: Path) ->
                     frame = sub.recv()
                     assert frame.startswith(response_prefix)
                     response = ManagerResponse.FromString(frame[frame.index(b"\0") + 1:])
-                    assert (response.client_name, response.client_pid) == ("goby_app", 4242)
+                    if (response.client_name, response.client_pid) != ("goby_app", 4242):
+                        continue  # another client's answer (the broker's own application's): a client reads its own
                     answers.append(response.hold)
                 if answers and (not until_released or answers[-1] is False):
                     return answers
