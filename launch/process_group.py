@@ -148,6 +148,7 @@ class ProcessGroup:
         self.terminate_interprocess: str | None = None
         self.processes: list[ManagedProcess] = []
         self.stop_event = threading.Event()
+        self.stop_reason: str | None = None  # why a stop was requested, reported by the thread that stops
         self._named_once = False
         self._reactor: Reactor | None = None
 
@@ -381,11 +382,16 @@ class ProcessGroup:
             reactor.close()
             for fd in watched.values():
                 os.close(fd)
+            if self.stop_reason is not None:
+                self.report(self.stop_reason)
             self.stop()
         return outcome["status"]
 
-    def request_stop(self) -> None:
-        """Ask ``start()``/``supervise()`` to stop everything (thread- and signal-safe)."""
+    def request_stop(self, reason: str | None = None) -> None:
+        """Ask ``start()``/``supervise()`` to stop everything (thread- and signal-safe: no I/O here); ``reason`` is
+        reported by the stopping thread (a print inside a signal handler can meet the same stream mid-write)."""
+        if reason is not None and self.stop_reason is None:
+            self.stop_reason = reason
         self.stop_event.set()
         reactor = self._reactor
         if reactor is not None:

@@ -119,9 +119,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"Sourcing {preseed} before each command", flush=True)
     group.preamble = preamble
     print(f"Logs in {log_dir}", flush=True)
-    def on_signal(signum: int) -> None:
-        group.report(f"\nReceived {signal.Signals(signum).name}")
-        group.request_stop()
+    def on_signal(signum: int) -> None:  # in a signal handler: flags only, the main thread reports
+        group.request_stop(f"\nReceived {signal.Signals(signum).name}")
 
     with handle_signals(on_signal):
         try:

@@ -27,6 +27,7 @@ from translators.trail.protobuf.nav_dccl_pb2 import NavigationReport
 from translators.usv.protobuf.command_dccl_pb2 import AUVCommand
 
 WARP = 20
+LOG_TIME_SLACK_S = 1.0  # sim seconds between the demo's clock and the times read back from the logs
 USV_SPEED = 1.5
 
 
@@ -89,9 +90,11 @@ def test_one_auv_trails_the_usv_contact_survives_a_simulator_restart_and_recover
         assert miss < 25, f"AUV at ({last.x:.0f},{last.y:.0f}), trail point ({target[0]:.0f},{target[1]:.0f})"
         assert all(s.depth is not None and abs(s.depth - 20) < 3 for s in recent), [s.depth for s in recent][-5:]
         # RECOVER: the gateway posts depth=0 then AUV_DEPLOY_STATE=RECOVER; the AUV surfaces and heads for (100,-100)
+        # Taken before the command (the gateway may post within ms), less a slack: the record's times are the logs'
+        # (the gateway's posting time; the alog's LOGSTART has 0.1 s resolution), not the demo's clock.
+        t_recover = mission.now() - LOG_TIME_SLACK_S
         client.publish(groups.auv_command, AUVCommand(time=time.time(), desired_state=AUVCommand.RECOVER))
         client.poll()
-        t_recover = mission.now()
         mission.run(None, until=lambda: mission.now() - t_recover > 200)
         events = [(e.name, e.value) for e in record.snapshot()[1] if e.name in ("DEPLOY_DEPTH_UPDATES",
                                                                              "AUV_DEPLOY_STATE") and e.t >= t_recover]
