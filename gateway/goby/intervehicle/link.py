@@ -329,7 +329,7 @@ class Link:
                 self._expire(dropped, dest, ExpireData.EXPIRED_BUFFER_OVERFLOW, now)
 
     def accept_subscription(self, sub: Subscription) -> None:
-        """A remote subscription from ``modem_subscription_forward_rx`` (Goby's ``_accept_subscription``)."""
+        """A remote subscription, received by this link or another of the vehicle (Goby's ``_accept_subscription``)."""
         dest = sub.header.src
         if not self.in_subnet(dest) or sub.api_version != groups.API_VERSION:
             return

@@ -11,11 +11,11 @@ reactor until a link has something to do (docs/intervehicle.md "Threads"):
 - a timer flushes held-back log lines, armed only once a line was held back; a link announces itself twice (at
   start, 2 s later) by one-shot timers.
 
-The application side's groups (``modem_data_out``, ``modem_subscription_forward_tx``/``_rx``) are subscribed once
-and handed to every link in turn; what a link reports is published on ``modem_data_in``, ``modem_ack_in``,
+The application side's groups (``modem_data_out``, ``modem_subscription_forward_tx``) are subscribed once and
+handed to every link in turn; what a link reports is published on ``modem_data_in``, ``modem_ack_in``,
 ``modem_expire_in``, ``subscription_report`` (and the diagnostics ``modem_transmit_result``,
-``mac_initiate_transmission``). Received Subscriptions go out on ``modem_subscription_forward_rx`` so every link
-sees them, as in Goby.
+``mac_initiate_transmission``). A Subscription one link receives is handed to every link at once, on this thread
+(Goby's ``modem_subscription_forward_rx``, an interthread group, plays this part).
 
 A link whose driver, MAC or timed work raises is reported (ERROR naming the link) and restarted on the same thread
 after a back-off, with a new driver and MAC but the old link's queues and subscriptions (``Link.take_over``); while
@@ -275,7 +275,7 @@ class LinkRunner:
             data_in=lambda m: ip.publish(groups.modem_data_in, m),
             ack_in=lambda m: ip.publish(groups.modem_ack_in, m),
             expire_in=lambda m: ip.publish(groups.modem_expire_in, m),
-            subscription_rx=lambda m: ip.publish(groups.modem_subscription_forward_rx, m),
+            subscription_rx=self.host.accept_subscription,
             subscription_report=lambda m: ip.publish(groups.subscription_report, m),
             transmitted=lambda m: ip.publish(groups.modem_transmit_result, with_id(m)),
             initiated=lambda m: ip.publish(groups.mac_initiate_transmission, with_id(m)),
@@ -298,12 +298,16 @@ class IntervehicleThread(SimpleThread):
                      lambda m: self._each(Link.buffer_message, m))
         ip.subscribe(groups.modem_subscription_forward_tx, Subscription,
                      lambda m: self._each(Link.forward_subscription, m))
-        ip.subscribe(groups.modem_subscription_forward_rx, Subscription,
-                     lambda m: self._each(Link.accept_subscription, m))
 
     def _each(self, method: Method, msg: Any) -> None:
         for runner in self.runners:
             runner.deliver(method, msg)
+
+    def accept_subscription(self, sub: Subscription) -> None:
+        """A Subscription one link received: every link takes it at once, on this thread (Goby hands it over by
+        interthread). Before a link acks the frame that carried it, so a publication prompted by that ack always
+        finds the subscriber; a round trip through the broker could lose that race."""
+        self._each(Link.accept_subscription, sub)
 
     def initialize(self) -> None:
         """Start every link (raises ``AcommsError`` naming the first that cannot start, the others stopped), wait

@@ -97,6 +97,10 @@ class InterProcessPortal:
             sock.setsockopt(zmq.RCVHWM, self._cfg.receive_queue_size)
             sock.setsockopt(zmq.IPV6, 1)
         self._pub.setsockopt(zmq.XPUB_NODROP, 1)  # a full queue is reported to us instead of dropping silently
+        # Every subscription the broker forwards reaches us, even one our XPUB already holds: after a quick broker
+        # restart the new connection's subscriptions can arrive before ZeroMQ has retired the dead one, and a
+        # non-verbose XPUB would then swallow them as duplicates, leaving the topic missing for RESUBSCRIBE_WAIT_S.
+        self._pub.setsockopt(zmq.XPUB_VERBOSE, 1)
         # No queue toward a broker that is not there: a new connection starts with no subscriptions, so what we
         # learn from the new broker is all there is (a kept queue would keep the dead broker's subscriptions).
         self._pub.setsockopt(zmq.IMMEDIATE, 1)
