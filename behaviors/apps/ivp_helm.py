@@ -19,39 +19,34 @@ from pathlib import Path
 from behaviors.helm.config import config_from_mission
 from behaviors.helm.helm import Helm, Post
 from gateway.apps.moos_tool_args import parse_moos_app_args
-from gateway.moos import MissionFileError, MoosClock, comms
+from gateway.moos import MoosClock
 from gateway.moos.message import BINARY, DOUBLE
 from gateway.moos.mission_file import MissionFile
-from util.process import handle_signals
-from util.reactor import Reactor, Timer
+from gateway.moos.reactor_app import MoosReactorApp, serve
+from util.reactor import Timer
 
 log = logging.getLogger(__name__)
 DEFAULT_APP_NAME = "pHelmIvP"
 
 
-class HelmApp:
+class HelmApp(MoosReactorApp):
     """One helm connected to one MOOSDB: :meth:`run` serves on the calling thread; :meth:`start` / :meth:`stop`
     (idempotent) serve on a thread of its own, or use it as a context manager."""
 
     def __init__(self, mission_path: str | Path, alias: str | None = None, clock: MoosClock | None = None,
                  host: str | None = None, port: int | None = None) -> None:
         self.mission = MissionFile(mission_path)
-        self.name = alias or DEFAULT_APP_NAME
-        config = config_from_mission(self.mission, self.name)
+        name = alias or DEFAULT_APP_NAME
+        config = config_from_mission(self.mission, name)
         if alias and not self.mission.has_process_config(alias) and self.mission.has_process_config(DEFAULT_APP_NAME):
             config = config_from_mission(self.mission, DEFAULT_APP_NAME)
-        self.clock = clock or MoosClock(config.time_warp)
-        self.host = host or self.mission.server_host
-        self.port = port or self.mission.server_port
+        super().__init__(name, clock or MoosClock(config.time_warp), host or self.mission.server_host,
+                         port or self.mission.server_port, f"helm-{name}")
         self.helm = Helm(config, app_name=self.name, ownship=self.mission.community)
-        self.reactor = Reactor(f"helm-{self.name}")
-        self.comms = comms(clock=self.clock, reactor=self.reactor)
         self._registrations = sorted(self.helm.registrations())
         self._tick: Timer | None = None
         self._thread: threading.Thread | None = None
-        self._stop_requested = False  # stop() came (perhaps before run() started its reactor)
         self._done = threading.Event()  # run() has returned
-        self.failure: BaseException | None = None  # why the helm stopped early, if it did
 
     @property
     def state(self) -> str:
@@ -61,12 +56,8 @@ class HelmApp:
     def run(self) -> None:
         """Connect and serve on the calling thread until :meth:`stop` (or a start-up failure: see :attr:`failure`)."""
         try:
-            self.comms.set_on_connect_callback(self._on_connect)
-            self.comms.run(self.host, self.port, self.name)
-            self.reactor.run(until=lambda: self._stop_requested)
+            super().run()
         finally:
-            self.comms.close(True)  # on this thread: writes out what the last pass posted (BHV_ERROR included)
-            self.reactor.close()
             self._done.set()
 
     def start(self) -> HelmApp:
@@ -76,8 +67,7 @@ class HelmApp:
 
     def stop(self) -> None:
         """Make :meth:`run` return (from any thread, a signal handler included); waits for :meth:`start`'s thread."""
-        self._stop_requested = True
-        self.reactor.stop()
+        super().stop()
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(10)
             self._thread = None
@@ -96,11 +86,11 @@ class HelmApp:
         try:
             self.run()
         except BaseException as exc:  # recorded for the owner; the helm is not running any more
-            self.failure = self.failure or exc
+            self.failure = self.failure or f"the helm thread has stopped ({exc!r}); no helm is running"
             log.critical("the helm thread has stopped: %r", exc, exc_info=exc)
 
     # ---- reactor work ----------------------------------------------------------------------------------
-    def _on_connect(self) -> bool:
+    def on_connect(self) -> bool:
         """Every (re)connection: note the registration time and register; the first one also starts the helm."""
         self.helm.registered_at = self.clock.time()  # before registering: mail can only follow registration
         for var in self._registrations:
@@ -109,10 +99,9 @@ class HelmApp:
             try:
                 self._publish(self.helm.startup(self.clock.time()))
             except Exception as exc:  # the helm cannot serve without its start-up: stop, main() exits non-zero
-                self.failure = exc
                 log.critical("the helm has stopped: start-up failed: %r", exc, exc_info=exc)
                 self._report_error(f"ivp-helm stopped: {exc!r}")
-                self.stop()
+                self.fail(f"the helm's start-up failed ({exc!r}); exiting, no helm is running")
                 return True
             self._tick = self.reactor.call_every(self._period, self._on_tick)
         return True
@@ -176,18 +165,8 @@ class HelmApp:
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_moos_app_args(argv, "ivp-helm", "A pHelmIvP-compatible helm in Python.", DEFAULT_APP_NAME)
-    try:
-        app = HelmApp(args.mission, alias=args.alias)
-    except MissionFileError as exc:
-        log.error("%s", exc)
-        return 2
-    with handle_signals(lambda _signum: app.stop()):
-        log.info("%s connecting to %s:%d (state %s)", app.name, app.host, app.port, app.state)
-        app.run()
-    if app.failure is not None:
-        log.critical("ivp-helm: the helm has stopped (%r); exiting, no helm is running", app.failure)
-        return 1
-    return 0
+    return serve(lambda: HelmApp(args.mission, alias=args.alias),
+                 lambda app: f"{app.name} connecting to {app.host}:{app.port} (state {app.state})", "ivp-helm")
 
 
 if __name__ == "__main__":

@@ -13,49 +13,32 @@ from pathlib import Path
 
 from behaviors.node_reporter import REGISTRATIONS, NodeReporter, NodeReporterConfig
 from gateway.apps.moos_tool_args import parse_moos_app_args
-from gateway.moos import MissionFileError, MoosClock, comms
+from gateway.moos import MoosClock
 from gateway.moos.mission_file import MissionFile
-from util.process import handle_signals
-from util.reactor import Reactor, Timer
+from gateway.moos.reactor_app import MoosReactorApp, serve
+from util.reactor import Timer
 
 log = logging.getLogger(__name__)
 DEFAULT_APP_NAME = "pNodeReporter"
 
 
-class NodeReporterApp:
+class NodeReporterApp(MoosReactorApp):
     """One reporter connected to the mission's MOOSDB, served by :meth:`run` on the calling thread."""
 
     def __init__(self, mission_path: str | Path, alias: str | None = None) -> None:
         self.mission = MissionFile(mission_path)
-        self.name = alias or DEFAULT_APP_NAME
-        block = self.name if self.mission.has_process_config(self.name) else DEFAULT_APP_NAME
+        name = alias or DEFAULT_APP_NAME
+        block = name if self.mission.has_process_config(name) else DEFAULT_APP_NAME
         where = f"{self.mission.path}: ProcessConfig = {block}"
         self.config = NodeReporterConfig.from_pairs(self.mission.process_config(block), where)
         for problem in self.config.problems:
             log.warning("%s", problem)
-        self.clock = MoosClock(self.mission.time_warp)
+        super().__init__(name, MoosClock(self.mission.time_warp), self.mission.server_host, self.mission.server_port,
+                         f"node-reporter-{name}")
         self.reporter = NodeReporter(self.mission.community, self.config)
-        self.reactor = Reactor(f"node-reporter-{self.name}")
-        self.comms = comms(clock=self.clock, reactor=self.reactor)
         self._tick: Timer | None = None
-        self._stop_requested = False
 
-    def run(self) -> None:
-        """Connect and serve on the calling thread until :meth:`stop`."""
-        try:
-            self.comms.set_on_connect_callback(self._on_connect)
-            self.comms.run(self.mission.server_host, self.mission.server_port, self.name)
-            self.reactor.run(until=lambda: self._stop_requested)
-        finally:
-            self.comms.close(True)
-            self.reactor.close()
-
-    def stop(self) -> None:
-        """Make :meth:`run` return (from any thread, a signal handler included)."""
-        self._stop_requested = True
-        self.reactor.stop()
-
-    def _on_connect(self) -> bool:
+    def on_connect(self) -> bool:
         """Every (re)connection registers; the first one starts the AppTick."""
         ok = all(self.comms.register(v, 0) for v in REGISTRATIONS)
         if self._tick is None:
@@ -75,16 +58,9 @@ class NodeReporterApp:
 def main(argv: list[str] | None = None) -> int:
     args = parse_moos_app_args(argv, "node-reporter", "NODE_REPORT_LOCAL from NAV_*, as pNodeReporter posts it.",
                                DEFAULT_APP_NAME)
-    try:
-        app = NodeReporterApp(args.mission, alias=args.alias)
-    except MissionFileError as exc:
-        log.error("%s", exc)
-        return 2
-    with handle_signals(lambda _signum: app.stop()):
-        log.info("%s reporting %s on %s:%d", app.name, app.mission.community, app.mission.server_host,
-                 app.mission.server_port)
-        app.run()
-    return 0
+    return serve(lambda: NodeReporterApp(args.mission, alias=args.alias),
+                 lambda app: f"{app.name} reporting {app.mission.community} on {app.host}:{app.port}",
+                 "node-reporter")
 
 
 if __name__ == "__main__":

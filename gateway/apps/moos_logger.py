@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import IO
 
 from gateway.apps.moos_tool_args import parse_moos_app_args
-from gateway.moos import MissionFileError, MoosClock, comms
+from gateway.moos import MissionFileError, MoosClock
 from gateway.moos.alog import (
     DEFAULT_DOUBLE_PRECISION,
     DEFAULT_STEM,
@@ -46,9 +46,9 @@ from gateway.moos.alog import (
 )
 from gateway.moos.message import BINARY, DOUBLE, STRING, MoosMessage
 from gateway.moos.mission_file import MissionFile
+from gateway.moos.reactor_app import MoosReactorApp, serve
 from gateway.moos.wildcard import wild_match
-from util.process import handle_signals
-from util.reactor import Reactor, Timer
+from util.reactor import Timer
 
 log = logging.getLogger(__name__)
 DEFAULT_APP_NAME = "pLogger"
@@ -255,28 +255,24 @@ class LogSession:
             raise first
 
 
-class LoggerApp:
+class LoggerApp(MoosReactorApp):
     """One logger on one MOOSDB: :meth:`run` serves on the calling thread until :meth:`stop` (any thread) or a
     failure (:attr:`failure`: the files cannot be written)."""
 
     def __init__(self, mission_path: str | Path, alias: str | None = None, clock: MoosClock | None = None,
                  host: str | None = None, port: int | None = None) -> None:
         self.mission = MissionFile(mission_path)
-        self.name = alias or DEFAULT_APP_NAME
-        block = self.name if self.mission.has_process_config(self.name) else DEFAULT_APP_NAME
+        name = alias or DEFAULT_APP_NAME
+        block = name if self.mission.has_process_config(name) else DEFAULT_APP_NAME
         self.cfg = LoggerConfig.from_mission(self.mission, block)
-        self.clock = clock or MoosClock(self.mission.time_warp)
-        self.host = host or self.mission.server_host
-        self.port = port or self.mission.server_port
-        self.reactor = Reactor(f"logger-{self.name}")
-        self.comms = comms(clock=self.clock, reactor=self.reactor)
+        super().__init__(name, clock or MoosClock(self.mission.time_warp), host or self.mission.server_host,
+                         port or self.mission.server_port, f"logger-{name}")
+        self.comms_tick = self.cfg.comms_tick
         self.command_key = self.name.upper() + "_CMD"
         self.logged: dict[str, LogRequest] = {r.var: r for r in self.cfg.logs}
         for var in SYSTEM_VARS:
             self.logged.setdefault(var, LogRequest(var, 0.0))
         self.session: LogSession | None = None
-        self.failure: str | None = None
-        self._stop_requested = False
         self._registered_at = -math.inf  # MOOS time of the last (re)registration
         self._last: dict[str, tuple[float, str, object]] = {}  # per variable: the last row written
         self._seen: dict[str, float] = {}  # per variable: MOOS time it was last received (MONITOR)
@@ -284,36 +280,29 @@ class LoggerApp:
         self.logstart = self.clock.time()
 
     # ---- running ----------------------------------------------------------------------------------------
-    def run(self) -> None:
-        """Open the first session, connect and serve until :meth:`stop`; a failure sets :attr:`failure`."""
+    def before_connect(self) -> bool:
+        """Open the first session (the files must be writable before anything is logged)."""
+        for text in self.cfg.unsupported:
+            log.warning("%s: %s", self.name, text)
         try:
-            for text in self.cfg.unsupported:
-                log.warning("%s: %s", self.name, text)
-            try:
-                self.session = LogSession(self.cfg, self.logstart, self.mission.path)
-            except AlogError as exc:
-                self.failure = str(exc)
-                return
-            log.info("%s logging to %s", self.name, self.session.directory_name)
-            self.comms.set_on_connect_callback(self._on_connect)
-            self.comms.run(self.host, self.port, self.name, self.cfg.comms_tick)
-            self._timers.append(self.reactor.call_every(self._tick_period, self._on_tick))
-            self._timers.append(self.reactor.call_every(lambda: MONITOR_PERIOD / self.clock.warp, self._on_monitor,
-                                                        align=False))
-            self.reactor.run(until=lambda: self._stop_requested)
-        finally:
-            for timer in self._timers:
-                timer.cancel()
-            self.comms.close(True)
-            if self.session is not None and self.failure is None:
-                self._on_tick()  # what arrived since the last tick
-            self._close_session()
-            self.reactor.close()
+            self.session = LogSession(self.cfg, self.logstart, self.mission.path)
+        except AlogError as exc:
+            self.failure = str(exc)
+            return False
+        log.info("%s logging to %s", self.name, self.session.directory_name)
+        return True
 
-    def stop(self) -> None:
-        """Make :meth:`run` return (from any thread, a signal handler included)."""
-        self._stop_requested = True
-        self.reactor.stop()
+    def after_connect(self) -> None:
+        self._timers.append(self.reactor.call_every(self._tick_period, self._on_tick))
+        self._timers.append(self.reactor.call_every(lambda: MONITOR_PERIOD / self.clock.warp, self._on_monitor,
+                                                    align=False))
+
+    def after_close(self) -> None:
+        for timer in self._timers:
+            timer.cancel()
+        if self.session is not None and self.failure is None:
+            self._on_tick()  # what arrived since the last tick
+        self._close_session()
 
     def _fail(self, text: str) -> None:
         self.failure = self.failure or text
@@ -333,7 +322,7 @@ class LoggerApp:
         return 1.0 / (self.cfg.app_tick * self.clock.warp)
 
     # ---- reactor work ----------------------------------------------------------------------------------
-    def _on_connect(self) -> bool:
+    def on_connect(self) -> bool:
         """Every (re)connection: the wildcard patterns first, then the named variables (their periods win)."""
         self._registered_at = self.clock.time()
         if self.cfg.wildcard:
@@ -456,26 +445,11 @@ class LoggerApp:
             self.comms.notify("LOGGER_DIRECTORY", self.session.directory_name)
 
 
-def run_logger(mission: str | Path, alias: str | None = None) -> int:
-    """Build and run a logger until a signal; the exit status for :func:`main`."""
-    try:
-        app = LoggerApp(mission, alias=alias)
-    except MissionFileError as exc:
-        log.error("%s", exc)
-        return 2
-    with handle_signals(lambda _signum: app.stop()):
-        log.info("%s connecting to %s:%d", app.name, app.host, app.port)
-        app.run()
-    if app.failure is not None:
-        log.critical("moos-logger stopped: %s", app.failure)
-        return 1
-    return 0
-
-
 def main(argv: list[str] | None = None) -> int:
     args = parse_moos_app_args(argv, "moos-logger", "A pLogger-compatible MOOS logger writing .alog files.",
                                DEFAULT_APP_NAME)
-    return run_logger(args.mission, args.alias)
+    return serve(lambda: LoggerApp(args.mission, alias=args.alias),
+                 lambda app: f"{app.name} connecting to {app.host}:{app.port}", "moos-logger")
 
 
 if __name__ == "__main__":

@@ -24,9 +24,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from gateway.apps.moos_tool_args import parse_moos_app_args
-from gateway.moos import MissionFileError, MoosClock, comms
+from gateway.moos import MissionFileError, MoosClock
 from gateway.moos.message import MoosMessage, to_bytes
 from gateway.moos.mission_file import MissionFile
+from gateway.moos.reactor_app import MoosReactorApp, serve
 from gateway.moos.share import (
     MAX_DATAGRAM,
     SUMMARY_INPUT,
@@ -40,9 +41,8 @@ from gateway.moos.share import (
     decode_datagram,
     encode_datagram,
 )
-from util.process import handle_signals
 from util.ratelimit import RateLimitedLog
-from util.reactor import Reactor, Timer
+from util.reactor import Timer
 
 log = logging.getLogger(__name__)
 DEFAULT_APP_NAME = "pShare"
@@ -86,13 +86,13 @@ def _bind_input(address: Address) -> socket.socket:
     return sock
 
 
-class ShareApp:
+class ShareApp(MoosReactorApp):
     """One pShare connected to one MOOSDB; :meth:`run` serves on the calling thread until :meth:`stop`."""
 
     def __init__(self, mission_path: str, alias: str | None = None) -> None:
         self.mission = MissionFile(mission_path)
-        self.name = alias or DEFAULT_APP_NAME
-        block = self.name if self.mission.has_process_config(self.name) else DEFAULT_APP_NAME
+        name = alias or DEFAULT_APP_NAME
+        block = name if self.mission.has_process_config(name) else DEFAULT_APP_NAME
         pairs = self.mission.process_config(block)
         self.where = f"{self.mission.path}: ProcessConfig = {block}"
         settings = ShareSettings()
@@ -116,14 +116,13 @@ class ShareApp:
         self.table = ShareTable(settings)
         self.counters = ShareCounters()
         self.bad = RateLimitedLog(log, period_s=10.0)
-        self.clock = MoosClock(self.mission.time_warp)
-        self.reactor = Reactor(f"share-{self.name}")
-        self.comms = comms(clock=self.clock, reactor=self.reactor)
+        super().__init__(name, MoosClock(self.mission.time_warp), self.mission.server_host, self.mission.server_port,
+                         f"share-{name}")
+        self.comms.set_on_mail_callback(self._on_mail)
         self.cmd_var = self.name.upper() + "_CMD"
         self._sockets: dict[Address, socket.socket] = {}
         self._out: dict[bool, socket.socket] = {}
         self._summary: Timer | None = None
-        self._stop_requested = False
         self.start_time = self.clock.time()
         for text in outputs:
             self._configure(text, True, startup=True)
@@ -182,26 +181,13 @@ class ShareApp:
         return sock
 
     # ---- running -------------------------------------------------------------------------------------------
-    def run(self) -> None:
-        try:
-            self.comms.set_on_connect_callback(self._on_connect)
-            self.comms.set_on_mail_callback(self._on_mail)
-            self.comms.run(self.mission.server_host, self.mission.server_port, self.name)
-            self.reactor.run(until=lambda: self._stop_requested)
-        finally:
-            self.comms.close(True)
-            self.reactor.close()
-            for sock in [*self._sockets.values(), *self._out.values()]:
-                sock.close()
-            self.bad.flush(final=True)
-            log.info("%s: %s", self.name, self.counters.describe())
+    def after_close(self) -> None:
+        for sock in [*self._sockets.values(), *self._out.values()]:
+            sock.close()
+        self.bad.flush(final=True)
+        log.info("%s: %s", self.name, self.counters.describe())
 
-    def stop(self) -> None:
-        """Make :meth:`run` return (any thread, a signal handler included)."""
-        self._stop_requested = True
-        self.reactor.stop()
-
-    def _on_connect(self) -> bool:
+    def on_connect(self) -> bool:
         """Every (re)connection: pShare's DoRegistrations, then the summaries (which follow them on the link)."""
         variables, wildcards = self.table.registrations()
         for var in variables:
@@ -290,17 +276,10 @@ class ShareApp:
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_moos_app_args(argv, "moos-share", "A pShare-compatible MOOS variable sharer.", DEFAULT_APP_NAME)
-    try:
-        app = ShareApp(args.mission, alias=args.alias)
-    except MissionFileError as exc:
-        log.error("%s", exc)
-        return 2
-    with handle_signals(lambda _signum: app.stop()):
-        log.info("%s connecting to %s:%d; outputs: %s; inputs: %s", app.name, app.mission.server_host,
-                 app.mission.server_port, app.table.output_summary() or "none",
-                 app.table.input_summary() or "none")
-        app.run()
-    return 0
+    return serve(lambda: ShareApp(args.mission, alias=args.alias),
+                 lambda app: (f"{app.name} connecting to {app.host}:{app.port}; outputs: "
+                              f"{app.table.output_summary() or 'none'}; inputs: {app.table.input_summary() or 'none'}"),
+                 "moos-share")
 
 
 if __name__ == "__main__":

@@ -32,7 +32,7 @@ import time
 from collections import Counter, deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, Protocol, TypeVar
 
 from frontseat.protobuf.frontseat_data_pb2 import NodeStatus, VehicleType
 from launch.liaison.form_schema import dccl_bounds
@@ -52,6 +52,7 @@ HEALTH_STATUS_TYPE = HealthStatus.DESCRIPTOR.full_name
 NAV_REPORT_TYPE = NavigationReport.DESCRIPTOR.full_name  # an AUV's acomms report, as the USV forwards it
 HEALTH_RESEND_S = 1.0  # real seconds between updates of the ages and the clock when nothing arrived
 Point = tuple[float, float]
+_M = TypeVar("_M", NodeStatus, NavigationReport)
 
 
 class Background(Protocol):
@@ -417,20 +418,32 @@ class MapModel:
                 "mode": self.mode, "mode_source": self.mode_source, "views": views, "geo": self.geo,
                 "helm_read": self.helm_views}
 
-    def _update_vehicle(self, group: str, payload: bytes) -> _Vehicle | None:
-        status = NodeStatus()
+    def _parse(self, cls: type[_M], group: str, payload: bytes) -> _M | None:
+        """``payload`` as a ``cls``, or None (counted and logged): bad input from the broker never stops the page."""
+        msg = cls()
         try:
-            status.ParseFromString(payload)
+            msg.ParseFromString(payload)
         except Exception as exc:  # noqa: BLE001 - bad input from the broker: report, keep serving
-            self._refuse("unparsable", "NodeStatus on %s does not parse: %s", group, exc)
+            self._refuse("unparsable", "%s on %s does not parse: %s", cls.__name__, group, exc)
             return None
-        if not status.HasField("local_fix"):
+        return msg
+
+    def _in_range(self, what: str, group: str, numbers: tuple[float, ...]) -> bool:
+        """Position, heading, speed and time all finite and the position on the map's grid; else refused (logged)."""
+        x, y = numbers[0], numbers[1]
+        if all(math.isfinite(v) for v in numbers) and max(abs(x), abs(y)) <= MAX_COORDINATE_M:
+            return True
+        self._refuse("non-finite", "%s on %s has a non-finite or out-of-range number (x %r, y %r, heading %r, "
+                     "speed %r, time %r): dropped", what, group, *numbers)
+        return False
+
+    def _update_vehicle(self, group: str, payload: bytes) -> _Vehicle | None:
+        status = self._parse(NodeStatus, group, payload)
+        if status is None or not status.HasField("local_fix"):
             return None
         x, y = status.local_fix.x, status.local_fix.y
         numbers = (x, y, status.pose.heading, status.speed.over_ground, status.time)
-        if not all(math.isfinite(v) for v in numbers) or max(abs(x), abs(y)) > MAX_COORDINATE_M:
-            self._refuse("non-finite", "NodeStatus on %s has a non-finite or out-of-range number (x %r, y %r, "
-                         "heading %r, speed %r, time %r): dropped", group, *numbers)
+        if not self._in_range("NodeStatus", group, numbers):
             return None
         kind = VehicleType.Name(status.type) if status.HasField("type") else ""
         vehicle = self._place((status.name or group)[:MAX_NAME_CHARS], group, kind, *numbers)
@@ -448,18 +461,11 @@ class MapModel:
     def _update_from_nav(self, group: str, payload: bytes) -> _Vehicle | None:
         """An AUV's NavigationReport (x/y on the same grid); a USV's or topside's is skipped (its own NodeStatus
         is drawn under its own name)."""
-        nav = NavigationReport()
-        try:
-            nav.ParseFromString(payload)
-        except Exception as exc:  # noqa: BLE001 - bad input from the broker: report, keep serving
-            self._refuse("unparsable", "NavigationReport on %s does not parse: %s", group, exc)
-            return None
-        if nav.type != NavigationReport.AUV or not nav.IsInitialized():
+        nav = self._parse(NavigationReport, group, payload)
+        if nav is None or nav.type != NavigationReport.AUV or not nav.IsInitialized():
             return None
         numbers = (nav.x, nav.y, nav.heading, nav.speed_over_ground, nav.time)
-        if not all(math.isfinite(v) for v in numbers) or max(abs(nav.x), abs(nav.y)) > MAX_COORDINATE_M:
-            self._refuse("non-finite", "NavigationReport on %s has a non-finite or out-of-range number: dropped",
-                         group)
+        if not self._in_range("NavigationReport", group, numbers):
             return None
         return self._place(vehicle_name(nav), group, "AUV", *numbers)
 
