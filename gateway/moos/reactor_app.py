@@ -12,8 +12,8 @@ import logging
 from collections.abc import Callable
 from typing import TypeVar
 
-from gateway.moos.clock import MoosClock
 from gateway.moos.client import comms
+from gateway.moos.clock import MoosClock
 from gateway.moos.mission_file import MissionFileError
 from util.process import handle_signals
 from util.reactor import Reactor
