@@ -26,7 +26,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from bench.platform_proc import children_by_parent, subtree
+from bench.platform_proc import children_by_parent, machine_ticks, program_name, subtree
 from launch.errors import LaunchError
 from launch.trail.links import LinkMonitor
 from launch.trail.mission import TrailMission, with_free_ports
@@ -36,25 +36,11 @@ CLK_TCK = os.sysconf("SC_CLK_TCK")
 PAGE = os.sysconf("SC_PAGE_SIZE")
 
 
-def _program(pid: int) -> str:
-    """A process's program: the console script or ``-m`` module it runs (``moos-db``, ``launch.trail.moos_gen``)."""
-    try:
-        argv = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
-    except OSError:
-        return "?"
-    args = [a.decode(errors="replace") for a in argv if a]
-    if len(args) > 2 and args[1] == "-m":
-        return args[2]
-    if len(args) > 1 and "python" in Path(args[0]).name:
-        return Path(args[1]).name
-    return Path(args[0]).name if args else "?"
-
-
 def _cpu_by_program(pids: list[int]) -> dict[str, float]:
     out: dict[str, float] = {}
     for pid in pids:
         cpu, _ = _cpu_and_rss([pid])
-        name = _program(pid)
+        name = program_name(pid)
         out[name] = out.get(name, 0.0) + cpu
     return out
 
@@ -69,12 +55,6 @@ def _cpu_by_pid(pids: list[int]) -> dict[int, tuple[float, float]]:
             continue
         out[pid] = ((int(fields[11]) + int(fields[12])) / CLK_TCK, int(fields[19]) / CLK_TCK)
     return out
-
-
-def _machine_ticks() -> tuple[float, float]:
-    """(busy, all) CPU seconds of the whole machine since boot, from /proc/stat (idle and iowait are not busy)."""
-    values = [int(v) for v in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
-    return (sum(values) - values[3] - values[4]) / CLK_TCK, sum(values) / CLK_TCK
 
 
 def _uptime() -> float:
@@ -126,9 +106,9 @@ def measure(n_auvs: int, warp: int, sim_seconds: float) -> dict[str, object]:
         pids0 = _cpu_by_pid(all0)
         programs0 = _cpu_by_program(all0)
         nav0 = {name: run.logs.counts.get("NAV_X", 0) for name, run in mission.runs.items() if run.logs.moos}
-        real0, sim0, machine0 = time.monotonic(), mission.now(), _machine_ticks()
+        real0, sim0, machine0 = time.monotonic(), mission.now(), machine_ticks()
         mission.run(None, until=lambda: mission.now() - sim0 >= sim_seconds)
-        real, sim, machine1 = time.monotonic() - real0, mission.now() - sim0, _machine_ticks()
+        real, sim, machine1 = time.monotonic() - real0, mission.now() - sim0, machine_ticks()
         row["machine_busy"] = (machine1[0] - machine0[0]) / max(1e-9, machine1[1] - machine0[1])
         tree = children_by_parent()
         per_platform = {name: _cpu_and_rss(subtree(pid, tree)) for name, pid in roots.items()}

@@ -3,7 +3,8 @@
 The real MOOSDB, pHelmIvP and gobyd listen on every address, so a benchmark that starts them re-executes itself
 under ``unshare -n`` (``-r`` when not root) and runs both sides in there: loopback up, with multicast and a route for
 it (Goby's UDP multicast driver joins its group without naming an interface, which needs a multicast route a fresh
-namespace lacks; ours names 127.0.0.1 and needs none). The re-run gets ``--in-netns`` so it does not do it again.
+namespace lacks; ours names 127.0.0.1 and needs none). The route's source is 127.0.0.1: a socket bound to
+0.0.0.0, as the real gobyd's link, would otherwise send from 0.0.0.0, which our links drop as no peer. The re-run gets ``--in-netns`` so it does not do it again.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from bench.progress import progress
 
 NETNS_FLAG = "--in-netns"
 REPO = Path(__file__).resolve().parents[1]
-SCRIPT = 'ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo && exec "$@"'
+SCRIPT = 'ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo src 127.0.0.1 && exec "$@"'
 
 
 def reexec_in_netns(module: str, argv: list[str], skipped: str, why_needed: str,

@@ -123,3 +123,41 @@ def cpu_between(before: Iterable[ProcSample], after: Iterable[ProcSample]) -> fl
     started meanwhile) counts whole; one seen only in ``before`` (ended meanwhile) is lost, as its counters are."""
     first = {(s.pid, s.start_ticks): s for s in before}
     return sum(process_cpu_between(first.get((s.pid, s.start_ticks)), s) for s in after)
+
+
+def program_name(pid: int) -> str:
+    """What a process runs: the console script or ``-m`` module (``moos-db``, ``launch.trail.moos_gen``) of a
+    Python process, else its executable's name (``MOOSDB``); "?" if it has gone."""
+    try:
+        args = [a.decode(errors="replace") for a in Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0") if a]
+    except OSError:
+        return "?"
+    if not args:
+        return "?"
+    if "python" in Path(args[0]).name and len(args) > 1:
+        return args[2] if args[1] == "-m" and len(args) > 2 else Path(args[1]).name
+    return Path(args[0]).name
+
+
+def wakeups(pid: int) -> int:
+    """Voluntary context switches of every thread of ``pid`` so far (a thread that ended is not counted)."""
+    total = 0
+    try:
+        tids = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return 0
+    for tid in tids:
+        try:
+            text = Path(f"/proc/{pid}/task/{tid}/status").read_text()
+        except OSError:
+            continue
+        for line in text.splitlines():
+            if line.startswith("voluntary_ctxt_switches:"):
+                total += int(line.split()[1])
+    return total
+
+
+def machine_ticks() -> tuple[int, int]:
+    """(busy, all) clock ticks of the whole machine since boot, from ``/proc/stat`` (idle and iowait are not busy)."""
+    values = [int(v) for v in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
+    return sum(values) - values[3] - values[4], sum(values)

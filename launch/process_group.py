@@ -221,8 +221,7 @@ class ProcessGroup:
 
     def _broker_interprocess(self) -> str | None:
         """The interprocess block of the one broker line, for goby-terminate (None: use SIGTERM), as goby_launch."""
-        brokers = [e for e in self.entries
-                   if os.path.basename(expand_vars(e.binary, e.environment(self.base_env))) in BROKER_PROGRAMS]
+        brokers = [e for e in self.entries if self._is_broker(e)]
         if len(brokers) != 1:
             self.report(f"Note: {'no line' if not brokers else 'more than one line'} launching a broker - will use "
                         "SIGTERM instead of goby_terminate to stop processes (unless marked with [kill=...])")
@@ -246,11 +245,15 @@ class ProcessGroup:
                         "instead of goby_terminate to stop processes")
         return block
 
+    def _is_broker(self, entry: LaunchEntry) -> bool:
+        """Whether a line runs a broker (ours or gobyd), its variables expanded: ``${TRAIL_GOBY_BROKER:-goby-broker}``."""
+        return os.path.basename(expand_vars(entry.binary, entry.environment(self.base_env))) in BROKER_PROGRAMS
+
     def kill_method(self, process: ManagedProcess) -> str:
         """How ``process`` is stopped: its ``kill=``, else goby_terminate (one broker line; not the broker) or SIGTERM."""
         entry = process.entry
         method = entry.kill if entry.kill_given else "goby_terminate"
-        if method == "goby_terminate" and (self.terminate_interprocess is None or entry.binary in BROKER_PROGRAMS):
+        if method == "goby_terminate" and (self.terminate_interprocess is None or self._is_broker(entry)):
             return "SIGTERM"
         return method
 
@@ -462,7 +465,7 @@ class ProcessGroup:
         if self.parallel_stop:
             # All at once, except the brokers: they go last, as goby_launch -P kills gobyd last, so the other
             # processes can still talk to them while they shut down.
-            brokers = [p for p in live if p.entry.binary in BROKER_PROGRAMS]
+            brokers = [p for p in live if self._is_broker(p.entry)]
             for wave in ([p for p in live if p not in brokers], brokers):
                 self._stop_all(wave)
         else:

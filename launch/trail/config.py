@@ -45,6 +45,7 @@ from launch.trail.settings import (
     vehicle_from_env,
 )
 from launch.usv.settings import USV_DIR
+from util.process import WaitTimeout, wait_until
 
 TEMPLATES = TRAIL_DIR / "templates"
 # goby-coroner and usv-health-monitor: the USV mission's templates, one list of expected names for both missions
@@ -161,7 +162,7 @@ def _peers_block(settings: TrailSettings) -> str:
 def _moosdb_flags(settings: TrailSettings, vehicle: Vehicle) -> str:
     """Our moos-db's ``--moos_address`` (TRAIL_MOOS_ADDRESS); nothing for the real MOOSDB, which binds every
     interface of its host."""
-    return "" if settings.moosdb == "MOOSDB" else f"--moos_address={settings.moos_address}"
+    return "" if os.path.basename(settings.moosdb) == "MOOSDB" else f"--moos_address={settings.moos_address}"
 
 
 def _channel_block(settings: TrailSettings, link: str) -> str:
@@ -252,7 +253,9 @@ def _goby_logger(settings: TrailSettings, vehicle: Vehicle) -> str:
     ``<run_dir>/logs/<platform>/<platform>_<time>.goby``, next to the moos-logger's .alog directory."""
     values = _values(settings, vehicle, "goby-logger")
     values["data_log_dir"] = vehicle.log_dir(settings)
-    values["load_shared_library"] = load_shared_library_lines()
+    # Goby3's goby_logger dlopen()s each load_shared_library and exits on a Python module name
+    values["load_shared_library"] = ("" if os.path.basename(settings.goby_logger) == "goby_logger"
+                                     else load_shared_library_lines())
     return render(SHARED_TEMPLATES / "goby_logger.pb.cfg.in", values)
 
 
@@ -334,6 +337,37 @@ def write_moos_files(settings: TrailSettings, vehicle: Vehicle) -> tuple[Path, P
     return moos, bhv
 
 
+MOOSDB_WAIT_S = 60.0  # a platform's processes all start at once; on a loaded machine the MOOSDB takes seconds
+
+
+def _moos_after_db(settings: TrailSettings, vehicle: Vehicle) -> str:
+    """``moos``, printed once the vehicle's MOOSDB listens. The real pHelmIvP posts its behaviour file's
+    ``initialize`` variables once, at start-up, whether or not it is connected: started before its MOOSDB (whose
+    line runs two config generators to the helm's one) it loses them and stays in PARK."""
+    moos, _ = write_moos_files(settings, vehicle)
+    port = vehicle.moos_port(settings)
+    try:
+        wait_until(lambda: _listening(port), MOOSDB_WAIT_S, f"the MOOSDB on port {port}", interval=0.1)
+    except WaitTimeout as exc:
+        raise MissionConfigError(str(exc)) from None
+    return str(moos)
+
+
+def _listening(port: int) -> bool:
+    """True when a TCP socket of this network namespace listens on ``port`` (``/proc/net/tcp``). No connection is
+    made: the real MOOSDB logs a client that never shakes hands as a protocol error."""
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        try:
+            rows = Path(table).read_text().splitlines()[1:]
+        except OSError:
+            continue
+        for row in rows:
+            fields = row.split()  # sl local_address rem_address st ...; st 0A is LISTEN
+            if len(fields) > 3 and fields[3] == "0A" and int(fields[1].rsplit(":", 1)[1], 16) == port:
+                return True
+    return False
+
+
 def _helm_command(settings: TrailSettings, vehicle: Vehicle) -> str:
     """The USV helm's command line: the MOOS helm on usv.moos (ivp), or goby-helm-example (goby)."""
     if settings.usv_helm == "goby":
@@ -369,6 +403,7 @@ GENERATORS: dict[str, Callable[[TrailSettings, Vehicle], str]] = {
     "commander": _vehicle_only(("topside",), "commander", _pb("commander.pb.cfg.in", "trail-commander")),
     "moosdb_flags": _vehicle_only(("usv", "auv"), "moosdb_flags", _moosdb_flags),
     "moos": lambda s, v: str(write_moos_files(s, v)[0]),
+    "moos_after_db": _moos_after_db,
     "bhv": lambda s, v: str(write_moos_files(s, v)[1]),
 }
 

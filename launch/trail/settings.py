@@ -59,7 +59,7 @@ _ENV = env_variables("TRAIL_", (
     "satellite_port", "acomms_port", "moosdb", "helm", "usv_helm", "liaison_address", "link_address", "schedule",
     "socket_dir",
     "east_duration", "south_duration", "acomms_channel", "satellite_channel", "moos_address", "broker_address",
-    "broker_port", "link_peers", "ais_address", "ais_port", "share_port_base", "usv_address"))
+    "broker_port", "link_peers", "ais_address", "ais_port", "share_port_base", "usv_address", "goby_logger"))
 CHANNEL_LINKS = ("satellite", "acomms")
 
 
@@ -80,6 +80,8 @@ class TrailSettings(EnvSettings):
     acomms_port: int = 54501
     moosdb: str = "moos-db"  # or MOOSDB
     helm: str = "ivp-helm"  # or pHelmIvP (the MOOS helm of every vehicle that runs one)
+    # or goby_logger (Goby3's), whose load_shared_library are shared libraries: ours names Python modules there
+    goby_logger: str = "goby-logger"
     usv_helm: str = "ivp"  # ivp: the MOOS helm with usv.bhv; goby: homework 3's goby-helm-example
     liaison_address: str = "127.0.0.1"  # the course binds 0.0.0.0; the page has no login, so loopback unless asked
     # the links' listen_address: loopback keeps every datagram on this machine; the course leaves Goby's default
