@@ -41,14 +41,13 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from bench.netns import NETNS_FLAG, reexec_in_netns
+from bench.netns import NETNS_FLAG, cpp_side_here
 from bench.progress import progress
 from bench.stats import markdown_table
 from gateway.goby.log import FILE_DESCRIPTOR_GROUP, EntryDecoder, LogReader, LogWriter, debug_text_line
 from gateway.goby.portal import Scheme
 from gateway.goby.portal.testing import PortalClient, app_process, broker_process
 from gateway.goby.protobuf.interprocess_config_pb2 import InterProcessPortalConfig
-from gateway.moos.testing import private_netns
 from tests.goby3_real import interprocess_text, short_ipc_dir
 from tests.protobuf.sample_messages_pb2 import Sample
 from util.cli import bounded_number
@@ -459,14 +458,12 @@ def main(argv: list[str] | None = None) -> int:
         progress("(C++ logger skipped: --python-only)")
     else:
         found, why = find_cpp()
-        if why is not None:
-            progress(f"(C++ logger skipped: {why})")
-        elif args.in_netns or private_netns():
+        here, status = cpp_side_here(why, args.in_netns, "bench.bench_logger", argv, "C++ logger",
+                                     "the real gobyd listens on all addresses")
+        if status is not None:
+            return status
+        if here:
             programs = found
-        else:
-            status = reexec_in_netns("bench.bench_logger", argv, "C++ logger", "the real gobyd listens on all addresses")
-            if status is not None:
-                return status
     sides = ["python", *(["cpp"] if programs else [])]
     with tempfile.TemporaryDirectory(prefix="bench_logger_") as tmp:
         work = Path(tmp)

@@ -39,7 +39,7 @@ from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 
-from bench.netns import NETNS_FLAG, reexec_in_netns
+from bench.netns import NETNS_FLAG, cpp_side_here
 from bench.platform_import_report import import_report
 from bench.platform_proc import ProcSample, cpu_between
 from bench.platform_vehicle import (
@@ -55,7 +55,6 @@ from bench.platform_vehicle import (
 )
 from bench.progress import progress
 from bench.stats import markdown_table
-from gateway.moos.testing import private_netns
 from launch.errors import LaunchError
 from launch.usv.mission import LAUNCH_FILE
 from util.cli import bounded_number
@@ -254,15 +253,12 @@ def main(argv: list[str] | None = None) -> int:
         progress("(C++ vehicle skipped: --python-only)")
     else:
         found, why = find_cpp_programs()
-        if why is not None:
-            progress(f"(C++ vehicle skipped: {why})")
-        elif args.in_netns or private_netns():
-            programs = found
-        else:
-            status = reexec_in_netns("bench.bench_platform", argv, "C++ vehicle",
+        here, status = cpp_side_here(why, args.in_netns, "bench.bench_platform", argv, "C++ vehicle",
                                      "the real MOOSDB listens on all addresses")
-            if status is not None:
-                return status
+        if status is not None:
+            return status
+        if here:
+            programs = found
     print(f"one USV vehicle, Python{' vs C++' if programs else ''}: {args.seconds:g} s measured per run after "
           f"{args.settle:g} s settling, {args.runs} run(s) per warp, {os.cpu_count()} cores"
           f"{f', Python from {root}' if root else ''}")

@@ -55,7 +55,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bench.bench_platform import ratio_cell, spread
-from bench.netns import NETNS_FLAG, reexec_in_netns
+from bench.netns import NETNS_FLAG, cpp_side_here
 from bench.platform_proc import (
     ProcSample,
     children_by_parent,
@@ -68,7 +68,6 @@ from bench.platform_proc import (
 from bench.platform_vehicle import driver_library, find_cpp_programs, run_directory
 from bench.progress import progress
 from bench.stats import markdown_table
-from gateway.moos.testing import private_netns
 from launch.errors import LaunchError
 from launch.launchfile import LaunchEntry
 from launch.trail.mission import TrailMission, all_launch_entries, with_free_ports
@@ -421,15 +420,12 @@ def main(argv: list[str] | None = None) -> int:
         progress("(C++ AUV skipped: --auvs 1 leaves no auv1 for it)")
     else:
         programs, why = find_programs()
-        if why is not None:
-            progress(f"(C++ AUV skipped: {why})")
-        elif args.in_netns or private_netns():
-            cpp_env = cpp_environment(programs)
-        else:
-            status = reexec_in_netns("bench.bench_trail_auv", argv, "C++ AUV",
+        here, status = cpp_side_here(why, args.in_netns, "bench.bench_trail_auv", argv, "C++ AUV",
                                      "the real MOOSDB and gobyd listen on all addresses")
-            if status is not None:
-                return status
+        if status is not None:
+            return status
+        if here:
+            cpp_env = cpp_environment(programs)
     print(f"one trail AUV, {'ours (auv0) vs C++ (auv1)' if cpp_env else 'ours (auv0) alone'}: mission of "
           f"{args.auvs} AUV(s) + USV + topside at warp {args.warp}, {args.seconds:g} s measured per run after "
           f"{args.settle:g} s settling, {args.runs} run(s), {os.cpu_count()} cores")

@@ -17,6 +17,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 
 from bench.progress import progress
+from gateway.moos.testing import private_netns
 
 NETNS_FLAG = "--in-netns"
 REPO = Path(__file__).resolve().parents[1]
@@ -43,3 +44,16 @@ def reexec_in_netns(module: str, argv: list[str], skipped: str, why_needed: str,
         return None
     say(f"(running inside a private network namespace: {why_needed})")
     return subprocess.call([*head, sys.executable, "-m", module, *argv, NETNS_FLAG], env=base, cwd=REPO)
+
+
+def cpp_side_here(why_missing: str | None, in_netns: bool, module: str, argv: list[str], skipped: str,
+                  why_needed: str) -> tuple[bool, int | None]:
+    """Where a benchmark's C++ side runs: ``(True, None)`` here (this is a private network namespace already),
+    ``(False, status)`` once the whole benchmark has run again inside one (return that status), ``(False, None)``
+    not at all (``why_missing``, or no namespace could be made: said, and the caller runs ours alone)."""
+    if why_missing is not None:
+        progress(f"({skipped} skipped: {why_missing})")
+        return False, None
+    if in_netns or private_netns():
+        return True, None
+    return False, reexec_in_netns(module, argv, skipped, why_needed)

@@ -31,7 +31,7 @@ class MoosReactorApp:
         self.name, self.clock, self.host, self.port = name, clock, host, port
         self.reactor = Reactor(reactor_name)
         self.comms = comms(clock=clock, reactor=self.reactor)
-        self.comms_tick = 0.0  # the client's CommsTick (0: the client's default)
+        self.comms_tick = 5.0  # the client's CommsTick (MOOS's default)
         self.failure: str | None = None
         self._stop_requested = False
 
@@ -57,10 +57,7 @@ class MoosReactorApp:
             if not self.before_connect():
                 return
             self.comms.set_on_connect_callback(self.on_connect)
-            if self.comms_tick:
-                self.comms.run(self.host, self.port, self.name, self.comms_tick)
-            else:
-                self.comms.run(self.host, self.port, self.name)
+            self.comms.run(self.host, self.port, self.name, self.comms_tick)
             self.after_connect()
             self.reactor.run(until=lambda: self._stop_requested)
         finally:
